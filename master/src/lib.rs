@@ -1,0 +1,1 @@
+//! The cosdem master: the Cosserat finite-element macro solver.

@@ -1,0 +1,1 @@
+//! Integration tests of cosdem live in `tests/tests/`, one file per behaviour.

@@ -1,0 +1,1 @@
+//! The cosdem worker: disc DEM assemblies, one per Gauss point.
