@@ -1,1 +1,4 @@
 //! The cosdem master: the Cosserat finite-element macro solver.
+
+/// The constitutive operator at the Gauss points: the trait the FE solver talks to.
+pub mod material;
