@@ -233,3 +233,19 @@ fn read_errors_name_the_file() {
     let v3 = text.replace("4.1 0 8", "3.0 0 8");
     assert!(matches!(parse_msh(&v3).unwrap_err(), GmshError::UnsupportedFormat { line: 2, .. }));
 }
+
+#[test]
+fn elements_in_several_groups_are_read_once() {
+    let v22 = read_msh(&data("square_q8_two_groups_v22.msh")).unwrap();
+    let v41 = read_msh(&data("square_q8_two_groups_v41.msh")).unwrap();
+    assert_eq!(v22, v41);
+    check_invariants(&v22);
+    let plain = read_msh(&data("square_q8_v22.msh")).unwrap();
+    // Same nodes and elements as the plain square; the first physical surface wins.
+    assert_eq!(v22.nodes, plain.nodes);
+    assert_eq!(v22.elements, plain.elements);
+    // "all" holds the whole boundary: 16 nodes, 8 edges, each once.
+    assert_eq!(v22.node_groups["all"].len(), 16);
+    assert_eq!(v22.edge_groups["all"].len(), 8);
+    assert_eq!(v22.edge_groups["top"], plain.edge_groups["top"]);
+}

@@ -19,7 +19,7 @@
 //! An element in several physical surfaces takes the first one. Every node must lie in the
 //! plane z = 0 (to within 1e-12 relative to its distance from the origin).
 
-use std::collections::{BTreeMap, BTreeSet, HashMap};
+use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
 use std::path::{Path, PathBuf};
 use std::str::FromStr;
 
@@ -705,10 +705,14 @@ fn assemble(
             .unwrap_or_else(|| tag.to_string())
     };
 
-    // Quadrilaterals keyed by element tag (msh 2.2 repeats an element once per physical group).
+    // Format 2.2 repeats an element, under a new tag, once per physical group it belongs to:
+    // an element is identified by its type and nodes, and keeps its first tag.
+    // Quadrilaterals by element tag.
     let mut quads: BTreeMap<u64, (QuadKind, Vec<u64>, Option<String>, usize)> = BTreeMap::new();
-    // Group name -> element tag -> (gmsh type, node tags).
+    let mut quad_seen: HashSet<(u32, Vec<u64>)> = HashSet::new();
+    // Group name -> element tag -> (gmsh type, node tags), and the elements already in it.
     let mut groups: BTreeMap<String, BTreeMap<u64, (u32, Vec<u64>)>> = BTreeMap::new();
+    let mut group_seen: HashSet<(String, u32, Vec<u64>)> = HashSet::new();
 
     for e in elements {
         let info = type_info(e.gmsh_type);
@@ -745,32 +749,30 @@ fn assemble(
         }
         if let Some(kind) = QuadKind::from_gmsh_type(e.gmsh_type) {
             let physical = e.physicals.first().map(|&p| group_name(2, p));
-            match quads.get(&e.tag) {
-                None => {
-                    quads.insert(e.tag, (kind, e.nodes, physical, e.line));
-                }
-                Some((_, nodes, _, _)) if *nodes == e.nodes => {}
-                Some(_) => {
-                    return Err(GmshError::Syntax {
-                        file: file.to_string(),
-                        line: e.line,
-                        message: format!(
-                            "element tag {} is used twice with different nodes",
-                            e.tag
-                        ),
-                    });
-                }
+            if !quad_seen.insert((e.gmsh_type, e.nodes.clone())) {
+                continue;
             }
+            if quads.contains_key(&e.tag) {
+                return Err(GmshError::Syntax {
+                    file: file.to_string(),
+                    line: e.line,
+                    message: format!("element tag {} is used twice", e.tag),
+                });
+            }
+            quads.insert(e.tag, (kind, e.nodes, physical, e.line));
             continue;
         }
         match (e.dim, e.gmsh_type) {
             (Some(0 | 1), 1 | 8 | 15) => {
                 let dim = e.dim.unwrap_or(1);
                 for &p in &e.physicals {
-                    groups
-                        .entry(group_name(dim, p))
-                        .or_default()
-                        .insert(e.tag, (e.gmsh_type, e.nodes.clone()));
+                    let name = group_name(dim, p);
+                    if group_seen.insert((name.clone(), e.gmsh_type, e.nodes.clone())) {
+                        groups
+                            .entry(name)
+                            .or_default()
+                            .insert(e.tag, (e.gmsh_type, e.nodes.clone()));
+                    }
                 }
             }
             (Some(0 | 1), _) if e.physicals.is_empty() => {}
