@@ -3,7 +3,7 @@
 
 mod io_support;
 
-use cosdem_master::io::gmsh::{GmshError, QuadKind, RawMesh, parse_msh, read_msh};
+use cosdem_master::io::gmsh::{GmshError, QuadKind, RawMesh, parse_msh, parse_msh_bytes, read_msh};
 use io_support::data;
 
 fn corner_area(m: &RawMesh, e: &[usize]) -> f64 {
@@ -248,4 +248,57 @@ fn elements_in_several_groups_are_read_once() {
     assert_eq!(v22.node_groups["all"].len(), 16);
     assert_eq!(v22.edge_groups["all"].len(), 8);
     assert_eq!(v22.edge_groups["top"], plain.edge_groups["top"]);
+}
+
+#[test]
+fn binary_41_matches_ascii() {
+    for name in ["square_q8", "square_q9", "plate_hole_q8"] {
+        let ascii = read_msh(&data(&format!("{name}_v41.msh"))).unwrap();
+        let mut binary = read_msh(&data(&format!("{name}_v41_bin.msh"))).unwrap();
+        // ASCII files print 16 significant digits; binary ones hold the exact doubles.
+        assert_eq!(ascii.nodes.len(), binary.nodes.len());
+        for (a, b) in ascii.nodes.iter().zip(&binary.nodes) {
+            assert!((a[0] - b[0]).abs() <= 1e-15 && (a[1] - b[1]).abs() <= 1e-15, "{name}");
+        }
+        binary.nodes = ascii.nodes.clone();
+        assert_eq!(ascii, binary, "{name}");
+    }
+    // Truncated binary data is an error naming the position, not a panic.
+    let bytes = std::fs::read(data("square_q8_v41_bin.msh")).unwrap();
+    for cut in (100..bytes.len()).step_by(97) {
+        let err = parse_msh_bytes(&bytes[..cut]).unwrap_err().to_string();
+        assert!(err.starts_with("<bytes>:"), "{err}");
+    }
+    // Binary 2.2 is not supported, and says so.
+    let mut v22 = bytes.clone();
+    v22[12..15].copy_from_slice(b"2.2");
+    assert!(matches!(
+        parse_msh_bytes(&v22).unwrap_err(),
+        GmshError::UnsupportedFormat { line: 2, .. }
+    ));
+}
+
+#[test]
+fn corrupted_files_give_errors_not_panics() {
+    for name in ["square_q8_v22.msh", "square_q9_v41.msh", "square_q8_v41_bin.msh"] {
+        let bytes = std::fs::read(data(name)).unwrap();
+        for i in 0..bytes.len() {
+            for replacement in [b'x', b'-', b'9', b'\n', 0xff] {
+                let mut b = bytes.clone();
+                b[i] = replacement;
+                let _ = parse_msh_bytes(&b);
+            }
+            let _ = parse_msh_bytes(&bytes[..i]);
+        }
+    }
+}
+
+#[test]
+fn absurd_counts_are_errors() {
+    let text = std::fs::read_to_string(data("square_q8_v22.msh")).unwrap();
+    let huge = text.replace("$Nodes\n21\n", "$Nodes\n18446744073709551615\n");
+    let err = parse_msh(&huge).unwrap_err().to_string();
+    assert!(err.contains("expected a node tag, found \"$EndNodes\""), "{err}");
+    let huge = text.replace("$Elements\n12\n", "$Elements\n9999999999999\n");
+    assert!(parse_msh(&huge).is_err());
 }

@@ -1,7 +1,7 @@
 //! Gmsh `.msh` reader for meshes of 8- and 9-node quadrilaterals.
 //!
 //! Reads the ASCII formats 2.2 (`gmsh -format msh22`) and 4.1 (`-format msh41`, Gmsh's
-//! default) into a [`RawMesh`]: node coordinates, quadrilateral connectivity and the named
+//! default), and binary 4.1 (`-format msh41 -bin`), into a [`RawMesh`]: node coordinates, quadrilateral connectivity and the named
 //! physical groups, with no finite-element types involved.
 //!
 //! What is kept:
@@ -16,7 +16,8 @@
 //! Nodes are renumbered `0..n` in increasing Gmsh tag order; nodes that no kept element uses
 //! (e.g. the centre point of a circle arc) are dropped. Elements keep increasing tag order.
 //! A physical group without a name in `$PhysicalNames` is named by its number (`"7"`).
-//! An element in several physical surfaces takes the first one. Every node must lie in the
+//! Format 2.2 repeats an element once per physical group it belongs to (under new tags); each
+//! element is read once, and an element in several physical surfaces takes the first one. Every node must lie in the
 //! plane z = 0 (to within 1e-12 relative to its distance from the origin).
 
 use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
@@ -197,14 +198,54 @@ pub struct RawMesh {
     pub edge_groups: BTreeMap<String, Vec<Vec<usize>>>,
 }
 
-/// Reads a `.msh` file (ASCII 2.2 or 4.1).
+/// Reads a `.msh` file: ASCII 2.2, ASCII 4.1 or binary 4.1.
 pub fn read_msh(path: &Path) -> Result<RawMesh> {
-    let text = std::fs::read_to_string(path)
-        .map_err(|source| GmshError::Io { path: path.to_path_buf(), source })?;
-    parse_named(&text, &path.display().to_string())
+    let bytes =
+        std::fs::read(path).map_err(|source| GmshError::Io { path: path.to_path_buf(), source })?;
+    parse_bytes_named(&bytes, &path.display().to_string())
 }
 
-/// Parses the text of a `.msh` file (ASCII 2.2 or 4.1); errors name the file `<string>`.
+/// Parses the bytes of a `.msh` file (ASCII 2.2, ASCII 4.1 or binary 4.1); errors name the
+/// file `<bytes>`.
+pub fn parse_msh_bytes(bytes: &[u8]) -> Result<RawMesh> {
+    parse_bytes_named(bytes, "<bytes>")
+}
+
+fn parse_bytes_named(bytes: &[u8], file: &str) -> Result<RawMesh> {
+    // The second line of `$MeshFormat` tells ASCII (file type 0) from binary (1).
+    let mut lines = bytes.split(|&b| b == b'\n');
+    if lines.next().map(|l| l.trim_ascii()) == Some(b"$MeshFormat".as_slice())
+        && let Some(format) = lines.next()
+    {
+        let t: Vec<&[u8]> =
+            format.split(|b| b.is_ascii_whitespace()).filter(|t| !t.is_empty()).collect();
+        if t.len() == 3 && t[1] == b"1" {
+            if t[0] == b"4.1" && t[2] == b"8" {
+                return binary::parse(bytes, file);
+            }
+            return Err(GmshError::UnsupportedFormat {
+                file: file.to_string(),
+                line: 2,
+                found: String::from_utf8_lossy(format).trim().to_string(),
+            });
+        }
+    }
+    match std::str::from_utf8(bytes) {
+        Ok(text) => parse_named(text, file),
+        Err(e) => {
+            let line = 1 + bytes[..e.valid_up_to()].iter().filter(|&&b| b == b'\n').count();
+            Err(GmshError::Syntax {
+                file: file.to_string(),
+                line,
+                message: "the text is not valid UTF-8 (a binary file without a binary \
+                          $MeshFormat?)"
+                    .to_string(),
+            })
+        }
+    }
+}
+
+/// Parses the text of an ASCII `.msh` file (2.2 or 4.1); errors name the file `<string>`.
 pub fn parse_msh(text: &str) -> Result<RawMesh> {
     parse_named(text, "<string>")
 }
@@ -355,6 +396,9 @@ impl Fields<'_> {
     }
 }
 
+/// Largest count from the file used to pre-allocate, so a corrupt count cannot exhaust memory.
+const CAPACITY_HINT: usize = 1 << 16;
+
 #[derive(Clone, Copy, PartialEq)]
 enum Version {
     V2,
@@ -456,17 +500,23 @@ fn parse_physical_names(
     f.finish()?;
     for _ in 0..n {
         let (line, text) = cur.expect("a physical name `dim tag \"name\"`")?;
-        let mut f = Fields { file: cur.file, line, toks: text.split_whitespace() };
-        let dim: u32 = f.next("a physical dimension")?;
-        let tag: i32 = f.next("a physical tag")?;
-        let rest = f.rest().join(" ");
-        let name = rest
-            .strip_prefix('"')
-            .and_then(|r| r.strip_suffix('"'))
-            .ok_or_else(|| f.syntax(format!("expected a quoted physical name, found {rest:?}")))?;
-        names.insert((dim, tag), name.to_string());
+        let (key, name) = physical_name_line(cur.file, line, text)?;
+        names.insert(key, name);
     }
     Ok(())
+}
+
+/// One `$PhysicalNames` line: `dim tag "name"`.
+fn physical_name_line(file: &str, line: usize, text: &str) -> Result<((u32, i32), String)> {
+    let mut f = Fields { file, line, toks: text.split_whitespace() };
+    let dim: u32 = f.next("a physical dimension")?;
+    let tag: i32 = f.next("a physical tag")?;
+    let rest = f.rest().join(" ");
+    let name = rest
+        .strip_prefix('"')
+        .and_then(|r| r.strip_suffix('"'))
+        .ok_or_else(|| f.syntax(format!("expected a quoted physical name, found {rest:?}")))?;
+    Ok(((dim, tag), name.to_string()))
 }
 
 /// 4.1 `$Entities`: (dimension, entity tag) -> physical tags.
@@ -489,7 +539,7 @@ fn parse_entities(cur: &mut Cursor<'_>) -> Result<HashMap<(u32, i32), Vec<i32>>>
                 f.next::<f64>("an entity coordinate")?;
             }
             let n_phys = f.count("the number of physical tags")?;
-            let mut phys = Vec::with_capacity(n_phys);
+            let mut phys = Vec::with_capacity(n_phys.min(CAPACITY_HINT));
             for _ in 0..n_phys {
                 phys.push(f.next::<i32>("a physical tag")?);
             }
@@ -525,7 +575,7 @@ fn parse_nodes_2(cur: &mut Cursor<'_>) -> Result<Vec<(NodeRec, usize)>> {
     let mut f = cur.fields("the number of nodes")?;
     let n = f.count("the number of nodes")?;
     f.finish()?;
-    let mut out = Vec::with_capacity(n);
+    let mut out = Vec::with_capacity(n.min(CAPACITY_HINT));
     for _ in 0..n {
         let mut f = cur.fields("a node `tag x y z`")?;
         let tag: u64 = f.next("a node tag")?;
@@ -547,7 +597,7 @@ fn parse_nodes_41(cur: &mut Cursor<'_>) -> Result<Vec<(NodeRec, usize)>> {
     f.next::<u64>("the maximum node tag")?;
     f.finish()?;
     let header_line = f.line;
-    let mut out = Vec::with_capacity(n_nodes);
+    let mut out = Vec::with_capacity(n_nodes.min(CAPACITY_HINT));
     for _ in 0..n_blocks {
         let mut f = cur.fields("a node block `dim tag parametric count`")?;
         let _dim: u32 = f.next("an entity dimension")?;
@@ -558,7 +608,7 @@ fn parse_nodes_41(cur: &mut Cursor<'_>) -> Result<Vec<(NodeRec, usize)>> {
         if parametric > 1 {
             return Err(f.syntax(format!("expected parametric flag 0 or 1, found {parametric}")));
         }
-        let mut tags = Vec::with_capacity(n);
+        let mut tags = Vec::with_capacity(n.min(CAPACITY_HINT));
         for _ in 0..n {
             let mut f = cur.fields("a node tag")?;
             tags.push(f.next::<u64>("a node tag")?);
@@ -587,13 +637,13 @@ fn parse_elements_2(cur: &mut Cursor<'_>) -> Result<Vec<ElemRec>> {
     let mut f = cur.fields("the number of elements")?;
     let n = f.count("the number of elements")?;
     f.finish()?;
-    let mut out = Vec::with_capacity(n);
+    let mut out = Vec::with_capacity(n.min(CAPACITY_HINT));
     for _ in 0..n {
         let mut f = cur.fields("an element `tag type ntags tags... nodes...`")?;
         let tag: u64 = f.next("an element tag")?;
         let gmsh_type: u32 = f.next("an element type")?;
         let n_tags = f.count("the number of element tags")?;
-        let mut tags = Vec::with_capacity(n_tags);
+        let mut tags = Vec::with_capacity(n_tags.min(CAPACITY_HINT));
         for _ in 0..n_tags {
             tags.push(f.next::<i32>("an element tag value")?);
         }
@@ -626,7 +676,7 @@ fn parse_elements_41(
     f.next::<u64>("the maximum element tag")?;
     f.finish()?;
     let header_line = f.line;
-    let mut out = Vec::with_capacity(n_elements);
+    let mut out = Vec::with_capacity(n_elements.min(CAPACITY_HINT));
     for _ in 0..n_blocks {
         let mut f = cur.fields("an element block `dim tag type count`")?;
         let dim: u32 = f.next("an entity dimension")?;
@@ -849,6 +899,299 @@ fn assemble(
         node_groups,
         edge_groups,
     })
+}
+
+/// Binary format 4.1: the same sections as ASCII, with the numbers stored as raw `int`
+/// (4 bytes), `size_t` (8 bytes) and `double` (8 bytes) in the writer's byte order.
+mod binary {
+    use super::*;
+
+    struct Bin<'a> {
+        file: &'a str,
+        d: &'a [u8],
+        pos: usize,
+        big_endian: bool,
+        /// (position, line there): line numbers are counted incrementally.
+        seen: std::cell::Cell<(usize, usize)>,
+    }
+
+    impl<'a> Bin<'a> {
+        /// Line number of the current position (counting newline bytes, also inside binary
+        /// data), for error messages that also give the byte offset.
+        fn line(&self) -> usize {
+            let pos = self.pos.min(self.d.len());
+            let (mut p, mut l) = self.seen.get();
+            if pos < p {
+                (p, l) = (0, 1);
+            }
+            l += self.d[p..pos].iter().filter(|&&b| b == b'\n').count();
+            self.seen.set((pos, l));
+            l
+        }
+
+        fn err(&self, message: String) -> GmshError {
+            GmshError::Syntax {
+                file: self.file.to_string(),
+                line: self.line(),
+                message: format!("at byte {}: {message}", self.pos),
+            }
+        }
+
+        /// The next non-empty text line, without its newline.
+        fn text_line(&mut self, what: &str) -> Result<(usize, &'a str)> {
+            loop {
+                if self.pos >= self.d.len() {
+                    return Err(self.err(format!("unexpected end of file: expected {what}")));
+                }
+                let line = self.line();
+                let rest = &self.d[self.pos..];
+                let len = rest.iter().position(|&b| b == b'\n').unwrap_or(rest.len());
+                let raw = &rest[..len];
+                let text = std::str::from_utf8(raw)
+                    .map_err(|_| self.err(format!("expected {what} as text")))?;
+                self.pos += (len + 1).min(rest.len());
+                if !text.trim().is_empty() {
+                    return Ok((line, text.trim()));
+                }
+            }
+        }
+
+        fn take<const N: usize>(&mut self, what: &str) -> Result<[u8; N]> {
+            let Some(bytes) = self.d.get(self.pos..self.pos + N) else {
+                return Err(self.err(format!("unexpected end of file: expected {what}")));
+            };
+            self.pos += N;
+            Ok(bytes.try_into().expect("slice of length N"))
+        }
+
+        fn int(&mut self, what: &str) -> Result<i32> {
+            let b = self.take::<4>(what)?;
+            Ok(if self.big_endian { i32::from_be_bytes(b) } else { i32::from_le_bytes(b) })
+        }
+
+        fn size(&mut self, what: &str) -> Result<u64> {
+            let b = self.take::<8>(what)?;
+            Ok(if self.big_endian { u64::from_be_bytes(b) } else { u64::from_le_bytes(b) })
+        }
+
+        fn double(&mut self, what: &str) -> Result<f64> {
+            let b = self.take::<8>(what)?;
+            Ok(if self.big_endian { f64::from_be_bytes(b) } else { f64::from_le_bytes(b) })
+        }
+
+        /// A count that must fit in the rest of the file at `min_bytes` per item.
+        fn count(&mut self, what: &str, min_bytes: usize) -> Result<usize> {
+            let at = self.pos;
+            let n = self.size(what)?;
+            let room = (self.d.len() - self.pos) / min_bytes.max(1);
+            if n > room as u64 {
+                self.pos = at;
+                return Err(self.err(format!("{what} {n} does not fit in the rest of the file")));
+            }
+            Ok(n as usize)
+        }
+
+        fn small_int(&mut self, what: &str, max: i32) -> Result<u32> {
+            let v = self.int(what)?;
+            if !(0..=max).contains(&v) {
+                self.pos -= 4;
+                return Err(self.err(format!("expected {what} in 0..={max}, found {v}")));
+            }
+            Ok(v as u32)
+        }
+
+        fn end_section(&mut self, name: &str) -> Result<()> {
+            let want = format!("$End{name}");
+            let (line, text) = self.text_line(&want)?;
+            if text != want {
+                return Err(GmshError::Syntax {
+                    file: self.file.to_string(),
+                    line,
+                    message: format!("expected {want}, found {text:?}"),
+                });
+            }
+            Ok(())
+        }
+    }
+
+    pub(super) fn parse(d: &[u8], file: &str) -> Result<RawMesh> {
+        let mut b = Bin { file, d, pos: 0, big_endian: false, seen: std::cell::Cell::new((0, 1)) };
+        b.text_line("$MeshFormat")?;
+        b.text_line("the mesh format line")?;
+        let one = b.take::<4>("the binary endianness marker")?;
+        b.big_endian = match one {
+            [1, 0, 0, 0] => false,
+            [0, 0, 0, 1] => true,
+            _ => {
+                return Err(
+                    b.err(format!("expected the integer 1 as endianness marker, found {one:?}"))
+                );
+            }
+        };
+        b.end_section("MeshFormat")?;
+
+        let mut physical_names = BTreeMap::new();
+        let mut entities: HashMap<(u32, i32), Vec<i32>> = HashMap::new();
+        let mut nodes = None;
+        let mut elements = None;
+        while b.pos < d.len() {
+            if d[b.pos..].iter().all(|c| c.is_ascii_whitespace()) {
+                break;
+            }
+            let (line, header) = b.text_line("a section header")?;
+            let Some(name) = header.strip_prefix('$') else {
+                return Err(GmshError::Syntax {
+                    file: file.to_string(),
+                    line,
+                    message: format!("expected a section header `$Name`, found {header:?}"),
+                });
+            };
+            match name {
+                "PhysicalNames" => {
+                    let (line, text) = b.text_line("the number of physical names")?;
+                    let mut f = Fields { file, line, toks: text.split_whitespace() };
+                    let n = f.count("the number of physical names")?;
+                    f.finish()?;
+                    for _ in 0..n {
+                        let (line, text) = b.text_line("a physical name")?;
+                        let (key, name) = physical_name_line(file, line, text)?;
+                        physical_names.insert(key, name);
+                    }
+                }
+                "Entities" => entities = read_entities(&mut b)?,
+                "Nodes" => nodes = Some(read_nodes(&mut b)?),
+                "Elements" => elements = Some(read_elements(&mut b, &entities)?),
+                _ => {
+                    // Skip an unneeded section by searching for its end marker.
+                    let want = format!("\n$End{name}");
+                    let rest = &d[b.pos.saturating_sub(1)..];
+                    let Some(k) = rest.windows(want.len()).position(|w| w == want.as_bytes())
+                    else {
+                        return Err(
+                            b.err(format!("unexpected end of file: expected {}", &want[1..]))
+                        );
+                    };
+                    b.pos = b.pos.saturating_sub(1) + k;
+                }
+            }
+            b.end_section(name)?;
+        }
+        let nodes = nodes.ok_or_else(|| structure(file, "no $Nodes section"))?;
+        let elements = elements.ok_or_else(|| structure(file, "no $Elements section"))?;
+        assemble(file, physical_names, nodes, elements)
+    }
+
+    fn read_entities(b: &mut Bin<'_>) -> Result<HashMap<(u32, i32), Vec<i32>>> {
+        let mut counts = [0; 4];
+        for (dim, c) in counts.iter_mut().enumerate() {
+            *c = b.count(&format!("the number of {dim}D entities"), 36)?;
+        }
+        let mut out = HashMap::new();
+        for (dim, &n) in counts.iter().enumerate() {
+            for _ in 0..n {
+                let tag = b.int("an entity tag")?;
+                for _ in 0..if dim == 0 { 3 } else { 6 } {
+                    b.double("an entity coordinate")?;
+                }
+                let n_phys = b.count("the number of physical tags", 4)?;
+                let mut phys = Vec::with_capacity(n_phys);
+                for _ in 0..n_phys {
+                    phys.push(b.int("a physical tag")?);
+                }
+                if dim > 0 {
+                    let n_bound = b.count("the number of bounding entities", 4)?;
+                    for _ in 0..n_bound {
+                        b.int("a bounding entity tag")?;
+                    }
+                }
+                out.insert((dim as u32, tag), phys);
+            }
+        }
+        Ok(out)
+    }
+
+    fn read_nodes(b: &mut Bin<'_>) -> Result<Vec<(NodeRec, usize)>> {
+        let n_blocks = b.count("the number of node blocks", 20)?;
+        let n_nodes = b.count("the number of nodes", 32)?;
+        b.size("the minimum node tag")?;
+        b.size("the maximum node tag")?;
+        let mut out = Vec::with_capacity(n_nodes);
+        for _ in 0..n_blocks {
+            let dim = b.small_int("an entity dimension", 3)?;
+            b.int("an entity tag")?;
+            let parametric = b.small_int("the parametric flag", 1)?;
+            let n = b.count("the number of nodes in the block", 32)?;
+            let mut tags = Vec::with_capacity(n);
+            for _ in 0..n {
+                tags.push(b.size("a node tag")?);
+            }
+            let extra = if parametric == 1 { dim as usize } else { 0 };
+            for tag in tags {
+                let line = b.line();
+                let x = b.double("a node x coordinate")?;
+                let y = b.double("a node y coordinate")?;
+                let z = b.double("a node z coordinate")?;
+                for _ in 0..extra {
+                    b.double("a parametric coordinate")?;
+                }
+                check_planar(b.file, line, tag, x, y, z)?;
+                out.push((NodeRec { tag, xy: [x, y] }, line));
+            }
+        }
+        if out.len() != n_nodes {
+            return Err(
+                b.err(format!("header declares {n_nodes} nodes, the blocks hold {}", out.len()))
+            );
+        }
+        Ok(out)
+    }
+
+    fn read_elements(
+        b: &mut Bin<'_>,
+        entities: &HashMap<(u32, i32), Vec<i32>>,
+    ) -> Result<Vec<ElemRec>> {
+        let n_blocks = b.count("the number of element blocks", 20)?;
+        let n_elements = b.count("the number of elements", 16)?;
+        b.size("the minimum element tag")?;
+        b.size("the maximum element tag")?;
+        let mut out = Vec::with_capacity(n_elements);
+        for _ in 0..n_blocks {
+            let dim = b.small_int("an entity dimension", 3)?;
+            let entity = b.int("an entity tag")?;
+            let at = b.pos;
+            let gmsh_type = b.int("an element type")?;
+            let n = b.count("the number of elements in the block", 16)?;
+            // Binary records have no line ends: the node count must come from the type.
+            let Some((_, _, n_nodes)) = u32::try_from(gmsh_type).ok().and_then(type_info) else {
+                b.pos = at;
+                return Err(b.err(format!("unknown element type {gmsh_type}")));
+            };
+            let physicals = entities.get(&(dim, entity)).cloned().unwrap_or_default();
+            for _ in 0..n {
+                let line = b.line();
+                let tag = b.size("an element tag")?;
+                let mut nodes = Vec::with_capacity(n_nodes);
+                for _ in 0..n_nodes {
+                    nodes.push(b.size("a node tag")?);
+                }
+                out.push(ElemRec {
+                    tag,
+                    gmsh_type: gmsh_type as u32,
+                    dim: Some(dim),
+                    physicals: physicals.clone(),
+                    nodes,
+                    line,
+                });
+            }
+        }
+        if out.len() != n_elements {
+            return Err(b.err(format!(
+                "header declares {n_elements} elements, the blocks hold {}",
+                out.len()
+            )));
+        }
+        Ok(out)
+    }
 }
 
 #[cfg(test)]

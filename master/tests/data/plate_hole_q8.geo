@@ -2,6 +2,7 @@
 // meshed with the Blossom recombination into 8-node quadrilaterals (Gmsh type 16).
 // Regenerate: gmsh -2 -order 2 -format msh22 plate_hole_q8.geo -o plate_hole_q8_v22.msh
 //             gmsh -2 -order 2 -format msh41 plate_hole_q8.geo -o plate_hole_q8_v41.msh
+//             gmsh -2 -order 2 -format msh41 -bin plate_hole_q8.geo -o plate_hole_q8_v41_bin.msh
 Mesh.SecondOrderIncomplete = 1;
 Mesh.RecombineAll = 1;
 Mesh.RecombinationAlgorithm = 1;

@@ -2,6 +2,7 @@
 // Second order incomplete: 8-node serendipity quadrilaterals (Gmsh type 16).
 // Regenerate: gmsh -2 -order 2 -format msh22 square_q8.geo -o square_q8_v22.msh
 //             gmsh -2 -order 2 -format msh41 square_q8.geo -o square_q8_v41.msh
+//             gmsh -2 -order 2 -format msh41 -bin square_q8.geo -o square_q8_v41_bin.msh
 Mesh.SecondOrderIncomplete = 1;
 Point(1) = {0, 0, 0, 1};
 Point(2) = {1, 0, 0, 1};

@@ -2,6 +2,7 @@
 // Second order complete: 9-node Lagrange quadrilaterals (Gmsh type 10), 3 x 2 elements.
 // Regenerate: gmsh -2 -order 2 -format msh22 square_q9.geo -o square_q9_v22.msh
 //             gmsh -2 -order 2 -format msh41 square_q9.geo -o square_q9_v41.msh
+//             gmsh -2 -order 2 -format msh41 -bin square_q9.geo -o square_q9_v41_bin.msh
 Mesh.SecondOrderIncomplete = 0;
 Point(1) = {0, 0, 0, 1};
 Point(2) = {1, 0, 0, 1};
