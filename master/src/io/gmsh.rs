@@ -1,8 +1,8 @@
 //! Gmsh `.msh` reader for meshes of 8- and 9-node quadrilaterals.
 //!
 //! Reads the ASCII formats 2.2 (`gmsh -format msh22`) and 4.1 (`-format msh41`, Gmsh's
-//! default), and binary 4.1 (`-format msh41 -bin`), into a [`RawMesh`]: node coordinates, quadrilateral connectivity and the named
-//! physical groups, with no finite-element types involved.
+//! default), and binary 4.1 (`-format msh41 -bin`), into a [`RawMesh`]: node coordinates,
+//! quadrilateral connectivity and the named physical groups, with no finite-element types.
 //!
 //! What is kept:
 //! - 2D elements of Gmsh type 16 (8-node serendipity, [`QuadKind::Q8`]) and type 10 (9-node
@@ -17,8 +17,9 @@
 //! (e.g. the centre point of a circle arc) are dropped. Elements keep increasing tag order.
 //! A physical group without a name in `$PhysicalNames` is named by its number (`"7"`).
 //! Format 2.2 repeats an element once per physical group it belongs to (under new tags); each
-//! element is read once, and an element in several physical surfaces takes the first one. Every node must lie in the
-//! plane z = 0 (to within 1e-12 relative to its distance from the origin).
+//! element is read once, and an element in several physical surfaces takes the first one.
+//! Every node must lie in the plane z = 0 (to within 1e-12 relative to its distance from the
+//! origin).
 
 use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
 use std::path::{Path, PathBuf};

@@ -2,8 +2,8 @@
 //!
 //! [`CsvWriter`] writes its header once, then appends each row with a single write and syncs
 //! it to disk, so a run killed at any moment leaves every finished row (and at worst no part
-//! of the row being written). Numbers are printed with [`super::fmt_f64`] and parse back to
-//! the same `f64`; NaN and infinities are written as `NaN`, `inf`, `-inf`.
+//! of the row being written). Numbers are printed with [`fmt_f64`](crate::output::fmt_f64)
+//! and parse back to the same `f64`; NaN and infinities are written as `NaN`, `inf`, `-inf`.
 
 use std::io::{Seek, SeekFrom, Write as _};
 use std::path::{Path, PathBuf};

@@ -5,7 +5,8 @@
 //! then a rename), and the series files (`.pvd`, `.csv`) are kept valid after every step, so a
 //! run killed at any moment leaves readable output listing every finished step.
 //!
-//! Numbers are printed by [`fmt_f64`]: the shortest text that parses back to the same `f64`.
+//! Numbers are printed by [`fmt_f64`](crate::output::fmt_f64): the shortest text that parses
+//! back to the same `f64`.
 
 /// CSV curves (load-displacement), one flushed row per converged step.
 pub mod csv;
@@ -105,7 +106,10 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
         .ok_or_else(|| invalid(path, "the path names no file".to_string()))?
         .to_string_lossy()
         .into_owned();
-    let tmp = dir.join(format!(".{name}.{}.tmp", std::process::id()));
+    // Unique per process and call, so concurrent writers never share a temporary file.
+    static COUNTER: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let n = COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let tmp = dir.join(format!(".{name}.{}-{n}.tmp", std::process::id()));
     let result = (|| {
         let mut f = std::fs::File::create(&tmp).map_err(io_err(&tmp, "create temporary file"))?;
         f.write_all(bytes).map_err(io_err(&tmp, "write temporary file"))?;
