@@ -244,3 +244,43 @@ fn invalid_pieces_are_rejected_and_nothing_is_written() {
 
     assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0, "nothing may be written");
 }
+
+#[test]
+fn base64_encoding_reads_back_exactly() {
+    use cosdem_master::output::vtk::{Encoding, write_vtu_encoded};
+    use io_support::binary_array;
+    let mesh = read_msh(&data("plate_hole_q8_v41_bin.msh")).unwrap();
+    let elements: Vec<Vec<usize>> = mesh.elements.iter().map(|e| e.nodes.clone()).collect();
+    let dofs: Vec<[f64; 3]> =
+        mesh.nodes.iter().map(|p| [p[0].sin() * 1e-3, -p[1] / 7.0, f64::MIN_POSITIVE]).collect();
+    let dir = scratch("vtk-base64");
+    let path = dir.join("plate.vtu");
+    let mut piece = nodal_piece(&path, &mesh.nodes, &elements, &dofs).unwrap();
+    piece.time = Some(1.0 / 3.0);
+    write_vtu_encoded(&path, &piece, Encoding::Base64).unwrap();
+    let ascii = piece.to_xml(&path).unwrap();
+    let binary = std::fs::read_to_string(&path).unwrap();
+    assert!(binary.len() < ascii.len());
+
+    let root = read_vtu(&path);
+    let f64s = |a: &Element| -> Vec<f64> {
+        binary_array(a, 8).iter().map(|b| f64::from_le_bytes(b[..].try_into().unwrap())).collect()
+    };
+    let i64s = |a: &Element| -> Vec<i64> {
+        binary_array(a, 8).iter().map(|b| i64::from_le_bytes(b[..].try_into().unwrap())).collect()
+    };
+    let time = root.child("UnstructuredGrid").child("FieldData").array("TimeValue");
+    assert_eq!(f64s(time), [1.0 / 3.0]);
+    let p = grid_piece(&root);
+    let points: Vec<f64> = mesh.nodes.iter().flat_map(|q| [q[0], q[1], 0.0]).collect();
+    assert_eq!(bits(&f64s(p.child("Points").child("DataArray"))), bits(&points));
+    let disp: Vec<f64> = dofs.iter().flat_map(|d| [d[0], d[1], 0.0]).collect();
+    assert_eq!(bits(&f64s(p.child("PointData").array("displacement"))), bits(&disp));
+    let conn: Vec<i64> = elements.iter().flatten().map(|&n| n as i64).collect();
+    assert_eq!(i64s(p.child("Cells").array("connectivity")), conn);
+    let offsets: Vec<i64> = (1..=elements.len() as i64).map(|k| 8 * k).collect();
+    assert_eq!(i64s(p.child("Cells").array("offsets")), offsets);
+    let types = binary_array(p.child("Cells").array("types"), 1);
+    assert!(types.iter().all(|t| t == &[23]));
+    assert_eq!(types.len(), elements.len());
+}

@@ -18,7 +18,8 @@ pub mod vtk;
 pub use csv::CsvWriter;
 pub use pvd::{PvdDataset, PvdWriter};
 pub use vtk::{
-    Cell, CellType, DataArray, VtuPiece, gauss_point_piece, nodal_piece, particle_piece, write_vtu,
+    Cell, CellType, DataArray, Encoding, VtuPiece, gauss_point_piece, nodal_piece, particle_piece,
+    write_vtu, write_vtu_encoded,
 };
 
 use std::fmt::Write as _;

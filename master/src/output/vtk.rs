@@ -183,20 +183,33 @@ impl VtuPiece {
         self.cell_data.push(array);
     }
 
-    /// Renders the piece as VTK XML text; `path` only names the file in errors.
+    /// Renders the piece as ASCII VTK XML text; `path` only names the file in errors.
     pub fn to_xml(&self, path: &Path) -> Result<String> {
+        self.to_xml_encoded(path, Encoding::Ascii)
+    }
+
+    /// Renders the piece as VTK XML text with the arrays in `encoding`; `path` only names the
+    /// file in errors.
+    pub fn to_xml_encoded(&self, path: &Path, encoding: Encoding) -> Result<String> {
         self.validate(path)?;
-        let mut s = String::with_capacity(64 * (self.points.len() + self.cells.len()) + 512);
+        let per_value = match encoding {
+            Encoding::Ascii => 24,
+            Encoding::Base64 => 11,
+        };
+        let values: usize = self.points.len() * 3
+            + self.cells.iter().map(|c| c.nodes.len() + 2).sum::<usize>()
+            + self.point_data.iter().chain(&self.cell_data).map(|a| a.values.len()).sum::<usize>();
+        let mut s = String::with_capacity(per_value * values + 1024);
         s.push_str("<?xml version=\"1.0\"?>\n");
         s.push_str(
             "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" \
              header_type=\"UInt64\">\n  <UnstructuredGrid>\n",
         );
         if let Some(t) = self.time {
-            s.push_str("    <FieldData>\n      <DataArray type=\"Float64\" Name=\"TimeValue\" ");
-            s.push_str("NumberOfTuples=\"1\" format=\"ascii\">\n        ");
-            push_f64(&mut s, t);
-            s.push_str("\n      </DataArray>\n    </FieldData>\n");
+            s.push_str("    <FieldData>\n");
+            let attrs = "type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\"";
+            push_array(&mut s, 6, attrs, Values::F64(&[t], 1), encoding);
+            s.push_str("    </FieldData>\n");
         }
         let _ = writeln!(
             s,
@@ -207,55 +220,39 @@ impl VtuPiece {
         for (tag, arrays) in [("PointData", &self.point_data), ("CellData", &self.cell_data)] {
             let _ = writeln!(s, "      <{tag}>");
             for a in arrays {
-                let _ = write!(
-                    s,
-                    "        <DataArray type=\"Float64\" Name=\"{}\" NumberOfComponents=\"{}\"",
+                let mut attrs = format!(
+                    "type=\"Float64\" Name=\"{}\" NumberOfComponents=\"{}\"",
                     escape(&a.name),
                     a.components
                 );
                 for (i, c) in a.component_names.iter().enumerate() {
-                    let _ = write!(s, " ComponentName{i}=\"{}\"", escape(c));
+                    let _ = write!(attrs, " ComponentName{i}=\"{}\"", escape(c));
                 }
-                s.push_str(" format=\"ascii\">\n");
-                for tuple in a.values.chunks(a.components) {
-                    push_tuple(&mut s, tuple);
-                }
-                s.push_str("        </DataArray>\n");
+                push_array(&mut s, 8, &attrs, Values::F64(&a.values, a.components), encoding);
             }
             let _ = writeln!(s, "      </{tag}>");
         }
         s.push_str("      <Points>\n");
-        s.push_str(
-            "        <DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n",
-        );
-        for p in &self.points {
-            push_tuple(&mut s, p);
-        }
-        s.push_str("        </DataArray>\n      </Points>\n      <Cells>\n");
-        s.push_str("        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n");
-        for c in &self.cells {
-            s.push_str("          ");
-            for (i, n) in c.nodes.iter().enumerate() {
-                if i > 0 {
-                    s.push(' ');
-                }
-                let _ = write!(s, "{n}");
-            }
-            s.push('\n');
-        }
-        s.push_str("        </DataArray>\n");
-        s.push_str("        <DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n");
+        let points = self.points.as_flattened();
+        let attrs = "type=\"Float64\" NumberOfComponents=\"3\"";
+        push_array(&mut s, 8, attrs, Values::F64(points, 3), encoding);
+        s.push_str("      </Points>\n      <Cells>\n");
+        let cells = Values::Cells(&self.cells);
+        push_array(&mut s, 8, "type=\"Int64\" Name=\"connectivity\"", cells, encoding);
         let mut offset = 0;
-        for c in &self.cells {
-            offset += c.nodes.len();
-            let _ = writeln!(s, "          {offset}");
-        }
-        s.push_str("        </DataArray>\n");
-        s.push_str("        <DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n");
-        for c in &self.cells {
-            let _ = writeln!(s, "          {}", c.cell_type.vtk_id());
-        }
-        s.push_str("        </DataArray>\n      </Cells>\n    </Piece>\n");
+        let offsets: Vec<i64> = self
+            .cells
+            .iter()
+            .map(|c| {
+                offset += c.nodes.len() as i64;
+                offset
+            })
+            .collect();
+        let offsets = Values::I64(&offsets);
+        push_array(&mut s, 8, "type=\"Int64\" Name=\"offsets\"", offsets, encoding);
+        let types: Vec<u8> = self.cells.iter().map(|c| c.cell_type.vtk_id()).collect();
+        push_array(&mut s, 8, "type=\"UInt8\" Name=\"types\"", Values::U8(&types), encoding);
+        s.push_str("      </Cells>\n    </Piece>\n");
         s.push_str("  </UnstructuredGrid>\n</VTKFile>\n");
         Ok(s)
     }
@@ -345,15 +342,113 @@ impl VtuPiece {
     }
 }
 
-fn push_tuple(s: &mut String, tuple: &[f64]) {
-    s.push_str("          ");
-    for (i, &v) in tuple.iter().enumerate() {
-        if i > 0 {
-            s.push(' ');
+/// How the arrays of a `.vtu` are stored.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Encoding {
+    /// Decimal text (`format="ascii"`), shortest round-trip form: readable, diffable.
+    #[default]
+    Ascii,
+    /// Raw little-endian bytes, base64-encoded inline (`format="binary"`), each array
+    /// preceded by its byte count as a `UInt64`: exact and about half the size.
+    Base64,
+}
+
+/// The contents of one `DataArray`.
+enum Values<'a> {
+    /// Values with so many per line (ASCII).
+    F64(&'a [f64], usize),
+    I64(&'a [i64]),
+    U8(&'a [u8]),
+    /// Connectivity: one cell per line (ASCII).
+    Cells(&'a [Cell]),
+}
+
+/// Writes one `<DataArray ...>` element, indented by `indent` spaces.
+fn push_array(s: &mut String, indent: usize, attrs: &str, values: Values<'_>, encoding: Encoding) {
+    let pad = " ".repeat(indent);
+    let format = match encoding {
+        Encoding::Ascii => "ascii",
+        Encoding::Base64 => "binary",
+    };
+    let _ = writeln!(s, "{pad}<DataArray {attrs} format=\"{format}\">");
+    match encoding {
+        Encoding::Ascii => match values {
+            Values::F64(v, per_line) => {
+                for tuple in v.chunks(per_line.max(1)) {
+                    s.push_str(&pad);
+                    s.push_str("  ");
+                    for (i, &x) in tuple.iter().enumerate() {
+                        if i > 0 {
+                            s.push(' ');
+                        }
+                        push_f64(s, x);
+                    }
+                    s.push('\n');
+                }
+            }
+            Values::I64(v) => {
+                for x in v {
+                    let _ = writeln!(s, "{pad}  {x}");
+                }
+            }
+            Values::U8(v) => {
+                for x in v {
+                    let _ = writeln!(s, "{pad}  {x}");
+                }
+            }
+            Values::Cells(cells) => {
+                for c in cells {
+                    s.push_str(&pad);
+                    s.push_str("  ");
+                    for (i, n) in c.nodes.iter().enumerate() {
+                        if i > 0 {
+                            s.push(' ');
+                        }
+                        let _ = write!(s, "{n}");
+                    }
+                    s.push('\n');
+                }
+            }
+        },
+        Encoding::Base64 => {
+            let mut bytes = Vec::new();
+            bytes.extend_from_slice(&[0; 8]);
+            match values {
+                Values::F64(v, _) => {
+                    v.iter().for_each(|x| bytes.extend_from_slice(&x.to_le_bytes()))
+                }
+                Values::I64(v) => v.iter().for_each(|x| bytes.extend_from_slice(&x.to_le_bytes())),
+                Values::U8(v) => bytes.extend_from_slice(v),
+                Values::Cells(cells) => cells.iter().flat_map(|c| &c.nodes).for_each(|&n| {
+                    bytes.extend_from_slice(&(n as i64).to_le_bytes());
+                }),
+            }
+            let len = (bytes.len() - 8) as u64;
+            bytes[..8].copy_from_slice(&len.to_le_bytes());
+            s.push_str(&pad);
+            s.push_str("  ");
+            push_base64(s, &bytes);
+            s.push('\n');
         }
-        push_f64(s, v);
     }
-    s.push('\n');
+    let _ = writeln!(s, "{pad}</DataArray>");
+}
+
+/// Standard base64 (RFC 4648) with padding.
+fn push_base64(s: &mut String, bytes: &[u8]) {
+    const ALPHABET: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    s.reserve(bytes.len().div_ceil(3) * 4);
+    for chunk in bytes.chunks(3) {
+        let b = [chunk[0], *chunk.get(1).unwrap_or(&0), *chunk.get(2).unwrap_or(&0)];
+        let n = (u32::from(b[0]) << 16) | (u32::from(b[1]) << 8) | u32::from(b[2]);
+        for k in 0..4 {
+            if k <= chunk.len() {
+                s.push(ALPHABET[((n >> (18 - 6 * k)) & 63) as usize] as char);
+            } else {
+                s.push('=');
+            }
+        }
+    }
 }
 
 /// Escapes text for an XML attribute value.
@@ -376,9 +471,14 @@ pub(crate) fn escape(text: &str) -> String {
     out
 }
 
-/// Writes `piece` to `path` (conventionally `*.vtu`) atomically.
+/// Writes `piece` to `path` (conventionally `*.vtu`) atomically, as ASCII.
 pub fn write_vtu(path: &Path, piece: &VtuPiece) -> Result<()> {
-    let xml = piece.to_xml(path)?;
+    write_vtu_encoded(path, piece, Encoding::Ascii)
+}
+
+/// Writes `piece` to `path` atomically with the arrays in `encoding`.
+pub fn write_vtu_encoded(path: &Path, piece: &VtuPiece, encoding: Encoding) -> Result<()> {
+    let xml = piece.to_xml_encoded(path, encoding)?;
     write_atomic(path, xml.as_bytes())
 }
 
@@ -474,6 +574,23 @@ mod tests {
         assert_eq!(CellType::from(QuadKind::Q9).node_count(), QuadKind::Q9.node_count());
         assert_eq!(CellType::Vertex.vtk_id(), 1);
         assert_eq!(CellType::Line.vtk_id(), 3);
+    }
+
+    #[test]
+    fn base64_matches_rfc_4648() {
+        let enc = |b: &[u8]| {
+            let mut s = String::new();
+            push_base64(&mut s, b);
+            s
+        };
+        assert_eq!(enc(b""), "");
+        assert_eq!(enc(b"f"), "Zg==");
+        assert_eq!(enc(b"fo"), "Zm8=");
+        assert_eq!(enc(b"foo"), "Zm9v");
+        assert_eq!(enc(b"foob"), "Zm9vYg==");
+        assert_eq!(enc(b"fooba"), "Zm9vYmE=");
+        assert_eq!(enc(b"foobar"), "Zm9vYmFy");
+        assert_eq!(enc(&[0xff, 0xfe, 0x00]), "//4A");
     }
 
     #[test]

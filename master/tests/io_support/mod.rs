@@ -9,9 +9,9 @@ pub fn data(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests").join("data").join(name)
 }
 
-/// A fresh, empty scratch directory for one test.
+/// A fresh, empty scratch directory for one test, under Cargo's `target/tmp`.
 pub fn scratch(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("cosdem-{test}-{}", std::process::id()));
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("cosdem-io-{test}"));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir
@@ -205,4 +205,36 @@ fn checker_rejects_malformed_xml() {
     assert!(parse("<a>&nope;</a>").is_err());
     assert!(parse("<a/><b/>").is_err());
     assert_eq!(parse("<a k=\"&lt;&amp;\">1 2</a>").unwrap().attr("k"), Some("<&"));
+}
+
+/// Decodes standard base64 with padding.
+pub fn base64_decode(text: &str) -> Vec<u8> {
+    let value = |c: u8| -> u32 {
+        match c {
+            b'A'..=b'Z' => (c - b'A') as u32,
+            b'a'..=b'z' => (c - b'a' + 26) as u32,
+            b'0'..=b'9' => (c - b'0' + 52) as u32,
+            b'+' => 62,
+            b'/' => 63,
+            _ => panic!("bad base64 character {c}"),
+        }
+    };
+    let t: Vec<u8> = text.bytes().filter(|c| !c.is_ascii_whitespace()).collect();
+    assert_eq!(t.len() % 4, 0, "base64 length");
+    let mut out = Vec::new();
+    for q in t.chunks(4) {
+        let pad = q.iter().filter(|&&c| c == b'=').count();
+        let n = q.iter().take(4 - pad).fold(0u32, |n, &c| (n << 6) | value(c)) << (6 * pad);
+        out.extend_from_slice(&n.to_be_bytes()[1..4 - pad]);
+    }
+    out
+}
+
+/// The values of a `format="binary"` VTK array: a UInt64 byte count, then the data.
+pub fn binary_array(array: &Element, width: usize) -> Vec<Vec<u8>> {
+    assert_eq!(array.attr("format"), Some("binary"));
+    let bytes = base64_decode(&array.text);
+    let len = u64::from_le_bytes(bytes[..8].try_into().unwrap()) as usize;
+    assert_eq!(len, bytes.len() - 8, "header byte count");
+    bytes[8..].chunks(width).map(|c| c.to_vec()).collect()
 }
