@@ -1,4 +1,4 @@
-//! VTK XML unstructured grids (`.vtu`, ASCII), readable by ParaView and VTK.
+//! VTK XML unstructured grids (`.vtu`, ASCII or base64 binary), readable by ParaView and VTK.
 //!
 //! One generic [`VtuPiece`] (points, cells of any [`CellType`], named `f64` arrays with any
 //! number of components on points and cells) serves every output of the solver; the
