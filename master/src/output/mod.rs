@@ -1,0 +1,224 @@
+//! Writing results: VTK XML unstructured grids, ParaView `.pvd` time series and CSV curves.
+//!
+//! Writers take plain data (coordinates, connectivity, named arrays of `f64`), never the
+//! solver's types. Whole files are written atomically (a temporary file in the same directory,
+//! then a rename), and the series files (`.pvd`, `.csv`) are kept valid after every step, so a
+//! run killed at any moment leaves readable output listing every finished step.
+//!
+//! Numbers are printed by [`fmt_f64`](crate::output::fmt_f64): the shortest text that parses
+//! back to the same `f64`.
+
+/// CSV curves (load-displacement), one flushed row per converged step.
+pub mod csv;
+/// ParaView `.pvd` collections: the time series of `.vtu` files.
+pub mod pvd;
+/// VTK XML unstructured grids (`.vtu`): meshes, Gauss-point clouds, particle snapshots.
+pub mod vtk;
+
+pub use csv::CsvWriter;
+pub use pvd::{PvdDataset, PvdWriter};
+pub use vtk::{
+    Cell, CellType, DataArray, Encoding, VtuPiece, gauss_point_piece, nodal_piece, particle_piece,
+    write_vtu, write_vtu_encoded,
+};
+
+use std::fmt::Write as _;
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Why output could not be written. Every variant names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum OutputError {
+    /// The operating system refused a read, write or rename.
+    #[error("{}: {action}: {source}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What was being done ("write", "rename", ...).
+        action: &'static str,
+        /// The operating-system error.
+        source: std::io::Error,
+    },
+    /// The data handed to a writer is inconsistent (array lengths, node indices, ...).
+    #[error("{}: {message}", path.display())]
+    InvalidData {
+        /// The file that was to be written.
+        path: PathBuf,
+        /// What is wrong, naming the array, cell or column and the offending value.
+        message: String,
+    },
+    /// A value is NaN or infinite (VTK's ASCII reader cannot read those back).
+    #[error("{}: array {array:?} has the non-finite value {value} at index {index}", path.display())]
+    NonFinite {
+        /// The file that was to be written.
+        path: PathBuf,
+        /// The array (or CSV column) holding the value.
+        array: String,
+        /// Index of the value within the flat array (or the CSV row).
+        index: usize,
+        /// The value.
+        value: f64,
+    },
+}
+
+/// Result of the output writers.
+pub type Result<T> = std::result::Result<T, OutputError>;
+
+pub(crate) fn invalid(path: &Path, message: String) -> OutputError {
+    OutputError::InvalidData { path: path.to_path_buf(), message }
+}
+
+pub(crate) fn io_err(
+    path: &Path,
+    action: &'static str,
+) -> impl FnOnce(std::io::Error) -> OutputError {
+    let path = path.to_path_buf();
+    move |source| OutputError::Io { path, action, source }
+}
+
+/// Formats an `f64` as the shortest decimal text that parses back to exactly the same value:
+/// plain notation for magnitudes in `[1e-5, 1e16)` and zero, scientific (`1.5e-7`) otherwise.
+/// Integral values print without a fraction (`3`). NaN and infinities print as Rust does
+/// (`NaN`, `inf`, `-inf`); the VTK writer rejects them.
+pub fn fmt_f64(x: f64) -> String {
+    let mut s = String::new();
+    push_f64(&mut s, x);
+    s
+}
+
+pub(crate) fn push_f64(out: &mut String, x: f64) {
+    let a = x.abs();
+    if a == 0.0 || (1e-5..1e16).contains(&a) || !x.is_finite() {
+        let _ = write!(out, "{x}");
+    } else {
+        let _ = write!(out, "{x:e}");
+    }
+}
+
+/// Writes `bytes` to `path` atomically: into a temporary file in the same directory, synced,
+/// then renamed over `path`. Readers see either the old or the new file, never a torn one.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    let name = path
+        .file_name()
+        .ok_or_else(|| invalid(path, "the path names no file".to_string()))?
+        .to_string_lossy()
+        .into_owned();
+    // Unique per process and call, so concurrent writers never share a temporary file.
+    static COUNTER: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let n = COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let tmp = dir.join(format!(".{name}.{}-{n}.tmp", std::process::id()));
+    let result = (|| {
+        let mut f = std::fs::File::create(&tmp).map_err(io_err(&tmp, "create temporary file"))?;
+        f.write_all(bytes).map_err(io_err(&tmp, "write temporary file"))?;
+        f.sync_all().map_err(io_err(&tmp, "sync temporary file"))?;
+        drop(f);
+        std::fs::rename(&tmp, path).map_err(io_err(path, "rename temporary file over"))
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result
+}
+
+/// The equivalent strain of Eq. 34 for one Gauss point.
+///
+/// `e = [e_xx, e_yy, e_xy, e_yx, k_x, k_y]` (THEORY section 1), `lc` the internal length.
+/// q = sqrt(1/2 e7^T M e7) with e7 = [d_xx, d_yy, d_zz, e_xy, e_yx, k_x lc, k_y lc], the normal
+/// strains replaced by their deviatoric parts d_ii = e_ii - tr/3 (plane strain: e_zz = 0,
+/// tr = e_xx + e_yy) and M = I3 (+) [[1/2, 1/2], [1/2, 1/2]] (+) I2, so
+/// q^2 = 1/2 (d_xx^2 + d_yy^2 + d_zz^2 + (e_xy + e_yx)^2 / 2 + lc^2 (k_x^2 + k_y^2)).
+pub fn equivalent_strain(e: &[f64; 6], lc: f64) -> f64 {
+    let tr = e[0] + e[1];
+    let d = [e[0] - tr / 3.0, e[1] - tr / 3.0, -tr / 3.0];
+    let shear = e[2] + e[3];
+    let q2 = 0.5
+        * (d[0] * d[0]
+            + d[1] * d[1]
+            + d[2] * d[2]
+            + 0.5 * shear * shear
+            + lc * lc * (e[4] * e[4] + e[5] * e[5]));
+    q2.sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fmt_f64_round_trips() {
+        let values = [
+            0.0,
+            -0.0,
+            1.0,
+            -3.0,
+            0.1,
+            1.0 / 3.0,
+            -2.5e-7,
+            1e-5,
+            9.99e-6,
+            1e16,
+            123456789.123,
+            f64::MAX,
+            f64::MIN_POSITIVE,
+            5e-324,
+            std::f64::consts::PI * 1e200,
+        ];
+        for v in values {
+            let s = fmt_f64(v);
+            assert_eq!(s.parse::<f64>().unwrap().to_bits(), v.to_bits(), "{v} -> {s}");
+            assert!(s.len() <= 25, "{s}");
+        }
+        assert_eq!(fmt_f64(3.0), "3");
+        assert_eq!(fmt_f64(0.25), "0.25");
+        assert_eq!(fmt_f64(1.5e-7), "1.5e-7");
+        // A deterministic sweep over many magnitudes and mantissas.
+        let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
+        for _ in 0..20_000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let v = f64::from_bits(x);
+            if v.is_finite() {
+                assert_eq!(fmt_f64(v).parse::<f64>().unwrap().to_bits(), v.to_bits());
+            }
+        }
+    }
+
+    #[test]
+    fn equivalent_strain_closed_forms() {
+        // Pure shear e_xy = e_yx = g/2 (symmetric, no rotation): q^2 = 1/2 * g^2 / 2.
+        let g = 0.02;
+        let q = equivalent_strain(&[0.0, 0.0, g / 2.0, g / 2.0, 0.0, 0.0], 0.1);
+        assert!((q - (g * g / 4.0).sqrt()).abs() < 1e-15);
+        // Skew part (e_xy = -e_yx, a relative rotation) does not count.
+        assert_eq!(equivalent_strain(&[0.0, 0.0, 0.3, -0.3, 0.0, 0.0], 1.0), 0.0);
+        // Uniaxial e_xx = a: d = (2a/3, -a/3, -a/3), q^2 = 1/2 * 6a^2/9 = a^2/3.
+        let a = 1e-3;
+        let q = equivalent_strain(&[a, 0.0, 0.0, 0.0, 0.0, 0.0], 0.0);
+        assert!((q - a / 3f64.sqrt()).abs() < 1e-18);
+        // Curvature scaled by lc: q = lc |k| / sqrt(2).
+        let q = equivalent_strain(&[0.0, 0.0, 0.0, 0.0, 3.0, 4.0], 0.01);
+        assert!((q - 0.05 / 2f64.sqrt()).abs() < 1e-15);
+        assert_eq!(equivalent_strain(&[0.0; 6], 1.0), 0.0);
+    }
+
+    #[test]
+    fn atomic_write_replaces_whole_file() {
+        let dir = std::env::temp_dir().join(format!("cosdem-atomic-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let p = dir.join("a.txt");
+        write_atomic(&p, b"first version, long").unwrap();
+        write_atomic(&p, b"second").unwrap();
+        assert_eq!(std::fs::read_to_string(&p).unwrap(), "second");
+        let leftovers: Vec<_> =
+            std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().file_name()).collect();
+        assert_eq!(leftovers.len(), 1, "{leftovers:?}");
+        let err = write_atomic(&dir.join("missing").join("x.vtu"), b"x").unwrap_err();
+        assert!(err.to_string().contains("missing"), "{err}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+}
