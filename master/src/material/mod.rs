@@ -6,6 +6,14 @@
 
 use cosdem_common::{GaussPointId, MacroDeformation, MicroResponse};
 
+mod elastic;
+mod failing;
+mod softening;
+
+pub use elastic::ElasticCosserat;
+pub use failing::FailureInjector;
+pub use softening::SofteningElastic;
+
 /// Identifies one trial evaluation: load step and Newton iteration within it.
 ///
 /// Workers use it to answer retries idempotently: the same id always gets the same answer.
@@ -39,7 +47,8 @@ pub enum MaterialError {
 }
 
 fn describe(points: &[(GaussPointId, String)]) -> String {
-    let mut s: Vec<String> = points.iter().take(8).map(|(id, why)| format!("{id}: {why}")).collect();
+    let mut s: Vec<String> =
+        points.iter().take(8).map(|(id, why)| format!("{id}: {why}")).collect();
     if points.len() > 8 {
         s.push(format!("and {} more", points.len() - 8));
     }
