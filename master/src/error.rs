@@ -65,8 +65,9 @@ pub enum Error {
     LinearSolver(String),
     /// The load increment was cut below the minimum and the step still fails.
     #[error(
-        "load step {step} failed at load factor {load_factor:.6e} with increment {increment:.3e} \
-         below the minimum {min_increment:.3e}: {reason}{}",
+        "load step {step} failed from load factor {load_factor:.6e} with increment \
+         {increment:.3e}, and halving it would go below the minimum {min_increment:.3e}: \
+         {reason}{}",
         describe_points(gauss_points)
     )]
     StepTooSmall {

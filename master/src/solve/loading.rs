@@ -198,3 +198,43 @@ impl Loading {
         Ok(LoadVectors { prescribed, prescribed_value, f_linear, f_constant })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::element::{ElementKind, QuadratureRule};
+
+    /// A pressure p on each side of a 2 x 1.5 rectangle adds up to p times the side length,
+    /// pointing into the body; a traction likewise (exact: quadratic shape functions on
+    /// straight edges, 3-point rule).
+    #[test]
+    fn edge_loads_add_up_to_their_resultants() {
+        for kind in [ElementKind::Q8, ElementKind::Q9] {
+            let mesh = Mesh::rectangle(kind, 2.0, 1.5, 3, 2, [0.0, 0.0]).unwrap();
+            let dofs =
+                DofMap::new(Field::Cosserat, mesh.n_nodes(), &vec![false; 3 * mesh.n_nodes()]);
+            let gauss = GaussData::new(&mesh, QuadratureRule::Gauss2x2).unwrap();
+            for (side, expect) in [
+                ("right", [-3.0, 0.0]),
+                ("left", [3.0, 0.0]),
+                ("top", [0.0, -4.0]),
+                ("bottom", [0.0, 4.0]),
+            ] {
+                let loading = Loading {
+                    edge_loads: vec![EdgeLoad {
+                        set: side.into(),
+                        kind: EdgeLoadKind::Pressure(2.0),
+                        ramp: Ramp::Linear,
+                    }],
+                    ..Default::default()
+                };
+                let v = loading.vectors(&mesh, &dofs, &gauss).unwrap();
+                let sum = [0, 1].map(|c| v.f_ext(1.0).iter().skip(c).step_by(3).sum::<f64>());
+                assert!(
+                    (sum[0] - expect[0]).abs() < 1e-13 && (sum[1] - expect[1]).abs() < 1e-13,
+                    "{side}: {sum:?}"
+                );
+            }
+        }
+    }
+}
