@@ -8,7 +8,7 @@ use cosdem_master::assembly::{Component, Field};
 use cosdem_master::element::{ElementKind, QuadratureRule};
 use cosdem_master::material::ElasticCosserat;
 use cosdem_master::mesh::Mesh;
-use cosdem_master::solve::{Dirichlet, Loading, Model, Solver, SolverSettings};
+use cosdem_master::solve::{Dirichlet, IterationTiming, Loading, Model, Solver, SolverSettings};
 use std::time::Instant;
 
 fn main() {
@@ -30,20 +30,27 @@ fn main() {
         let mut solver = Solver::new(model, SolverSettings::default()).unwrap();
         let setup = t.elapsed().as_secs_f64() * 1e3;
         let mut mat = ElasticCosserat::new(1e7, 0.3, 5e6, 0.01);
-        let t = Instant::now();
-        solver.iteration_work(&mut mat).unwrap(); // includes the symbolic analysis
-        let first = t.elapsed().as_secs_f64() * 1e3;
+        let first = solver.iteration_work(&mut mat).unwrap(); // includes the symbolic analysis
         let reps = if n >= 200 { 3 } else { 10 };
-        let t = Instant::now();
+        let mut sum = IterationTiming::default();
         for _ in 0..reps {
-            std::hint::black_box(solver.iteration_work(&mut mat).unwrap());
+            let t = std::hint::black_box(solver.iteration_work(&mut mat).unwrap());
+            sum.material_s += t.material_s / reps as f64;
+            sum.assembly_s += t.assembly_s / reps as f64;
+            sum.solve_s += t.solve_s / reps as f64;
         }
-        let per = t.elapsed().as_secs_f64() * 1e3 / reps as f64;
+        let ms = |s: f64| s * 1e3;
         println!(
-            "Q8 {n}x{n}: {} free dofs, nnz {}: setup {setup:.1} ms, first iteration (with \
-             symbolic analysis) {first:.1} ms, then {per:.2} ms per Newton iteration",
+            "Q8 {n}x{n}: {} free dofs, nnz {}: setup {setup:.1} ms; first iteration {:.1} ms \
+             (symbolic analysis included); then per Newton iteration {:.2} ms = material {:.2} + \
+             assembly {:.2} + factorization and solve {:.2}",
             solver.dofs().n_free,
-            solver.pattern().nnz()
+            solver.pattern().nnz(),
+            ms(first.material_s + first.assembly_s + first.solve_s),
+            ms(sum.material_s + sum.assembly_s + sum.solve_s),
+            ms(sum.material_s),
+            ms(sum.assembly_s),
+            ms(sum.solve_s),
         );
     }
 }

@@ -8,5 +8,5 @@ mod observer;
 
 pub use linear::LinearSolver;
 pub use loading::{BodyLoad, Dirichlet, EdgeLoad, EdgeLoadKind, LoadVectors, Loading, Ramp};
-pub use newton::{Model, RunSummary, Solver, SolverSettings};
+pub use newton::{IterationTiming, Model, RunSummary, Solver, SolverSettings};
 pub use observer::{GaussPointState, SolutionView, StepObserver, StepReport};

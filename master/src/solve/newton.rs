@@ -75,6 +75,19 @@ impl Default for SolverSettings {
 }
 
 impl SolverSettings {
+    /// Number of nominal steps that moves a boundary by `total` in increments of at most
+    /// `increment` (for jobs that give a displacement increment instead of a step count).
+    pub fn steps_for_increment(total: f64, increment: f64) -> Result<usize> {
+        if !(increment.abs() > 0.0 && increment.is_finite() && total.is_finite()) {
+            return Err(Error::InvalidSetting {
+                field: "increment",
+                value: increment.to_string(),
+                reason: "must be finite and non-zero".into(),
+            });
+        }
+        Ok(((total / increment).abs() - 1e-9).ceil().max(1.0) as usize)
+    }
+
     fn check(&self) -> Result<()> {
         let bad = |field: &'static str, value: String, reason: &str| {
             Err(Error::InvalidSetting { field, value, reason: reason.into() })
@@ -528,17 +541,16 @@ impl Solver {
 
     /// One Newton iteration's work at the converged state, for benchmarks: material
     /// evaluation, assembly of residual and tangent, numeric factorization and solve.
-    /// Returns the norm of the solution of `K x = -r`.
-    pub fn iteration_work(&mut self, material: &mut dyn Material) -> Result<f64> {
+    pub fn iteration_work(&mut self, material: &mut dyn Material) -> Result<IterationTiming> {
         let symmetric = material.is_symmetric();
-        let responses = match self.evaluate(
-            material,
-            TrialId { step: self.step + 1, iteration: 0 },
-            &self.u,
-        )? {
+        let t = std::time::Instant::now();
+        let trial = TrialId { step: self.step + 1, iteration: 0 };
+        let responses = match self.evaluate(material, trial, &self.u)? {
             Ok(r) => r,
             Err(f) => return Err(Error::LinearSolver(f.reason())),
         };
+        let material_s = t.elapsed().as_secs_f64();
+        let t = std::time::Instant::now();
         let asm = self.operator.assemble(
             &self.model.mesh,
             &self.dofs,
@@ -550,8 +562,22 @@ impl Solver {
         );
         let f_ext = self.loads.f_ext(1.0);
         let (r, _) = self.residual(&asm.f_int, &f_ext);
+        let assembly_s = t.elapsed().as_secs_f64();
+        let t = std::time::Instant::now();
         let mut rhs: Vec<f64> = r.iter().map(|x| -x).collect();
         self.linear.solve(&self.values, &mut rhs, symmetric).map_err(Error::LinearSolver)?;
-        Ok(norm(&rhs))
+        Ok(IterationTiming { material_s, assembly_s, solve_s: t.elapsed().as_secs_f64() })
     }
+}
+
+/// Wall time of the parts of one Newton iteration (see [`Solver::iteration_work`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct IterationTiming {
+    /// Kinematics and material evaluation (s).
+    pub material_s: f64,
+    /// Residual and tangent assembly (s).
+    pub assembly_s: f64,
+    /// Numeric factorization and triangular solves (s; the first call includes the symbolic
+    /// analysis).
+    pub solve_s: f64,
 }
