@@ -4,25 +4,17 @@
 
 use cosdem_common::GaussPointId;
 use cosdem_master::Error;
-use cosdem_master::assembly::{Component, Field};
+use cosdem_master::assembly::Field;
 use cosdem_master::element::{ElementKind, QuadratureRule};
 use cosdem_master::material::{ElasticCosserat, FailureInjector, SofteningElastic};
 use cosdem_master::mesh::Mesh;
-use cosdem_master::solve::{Dirichlet, Loading, Model, Solver, SolverSettings, StepReport};
+use cosdem_master::solve::{Loading, Model, Platens, Solver, SolverSettings, StepReport};
 
 /// Scene A with rough platens: u_x = 0 on top and bottom, u_y = 0 at the bottom and
 /// `top_uy` at the top; w free.
 fn panel(top_uy: f64) -> Model {
     let mesh = Mesh::rectangle(ElementKind::Q8, 1.0, 1.0, 2, 2, [0.0, 0.0]).unwrap();
-    let loading = Loading {
-        dirichlet: vec![
-            Dirichlet::new("bottom", Component::Ux, 0.0),
-            Dirichlet::new("bottom", Component::Uy, 0.0),
-            Dirichlet::new("top", Component::Ux, 0.0),
-            Dirichlet::new("top", Component::Uy, top_uy),
-        ],
-        ..Default::default()
-    };
+    let loading = Loading::compression(top_uy, 0.0, Platens::Rough);
     Model { mesh, field: Field::Cosserat, rule: QuadratureRule::Gauss2x2, loading }
 }
 
@@ -149,4 +141,70 @@ fn cholesky_and_lu_paths_agree() {
     for (x, y) in a.solution().dofs.iter().zip(b.solution().dofs) {
         assert!((x - y).abs() < 1e-10 * 0.02, "{x} vs {y}");
     }
+}
+
+/// Elastic stresses but a tangent scaled by 0.4: each full Newton update on a pressure load
+/// overshoots 2.5 times, so the residual grows (r -> -1.5 r); the line search halves the
+/// update (r -> -0.25 r) and the run converges, linearly. Printed: halvings and iterations.
+#[test]
+fn line_search_engages_when_the_residual_grows() {
+    struct SoftTangent(ElasticCosserat);
+    impl cosdem_master::material::Material for SoftTangent {
+        fn evaluate(
+            &mut self,
+            trial: cosdem_master::material::TrialId,
+            inputs: &[cosdem_master::material::MaterialInput],
+        ) -> Result<Vec<cosdem_common::MicroResponse>, cosdem_master::material::MaterialError>
+        {
+            let mut r = self.0.evaluate(trial, inputs)?;
+            for x in &mut r {
+                x.tangent = x.tangent.map(|row| row.map(|v| 0.4 * v));
+            }
+            Ok(r)
+        }
+        fn commit(&mut self, _: u64) -> Result<(), cosdem_master::material::MaterialError> {
+            Ok(())
+        }
+        fn rollback(&mut self) -> Result<(), cosdem_master::material::MaterialError> {
+            Ok(())
+        }
+    }
+    let mut model = panel(0.0);
+    model.loading.dirichlet.retain(|d| d.set == "bottom");
+    model.loading.edge_loads.push(cosdem_master::solve::EdgeLoad {
+        set: "top".into(),
+        kind: cosdem_master::solve::EdgeLoadKind::Pressure(1e5),
+        ramp: cosdem_master::solve::Ramp::Linear,
+    });
+    let settings = SolverSettings { steps: 1, max_iterations: 40, ..Default::default() };
+    let mut solver = Solver::new(model, settings).unwrap();
+    let mut log: Vec<StepReport> = Vec::new();
+    solver.run(&mut SoftTangent(elastic()), &mut log).unwrap();
+    let s = &log[0];
+    println!(
+        "halvings {} iterations {} residuals {:?}",
+        s.line_search_halvings,
+        s.iterations,
+        sci(&s.residuals)
+    );
+    assert!(s.line_search_halvings > 0 && s.cuts == 0);
+    // the top reaction balances the pressure: 1e5 Pa on 1 m
+    assert!((log[0].reactions["bottom"][1] - 1e5).abs() < 1e-6 * 1e5, "{:?}", log[0].reactions);
+}
+
+/// Smooth platens on an elastic panel give the homogeneous uniaxial plane-strain state:
+/// e_yy = -d, s_xx = 0 gives e_xx = -lam/(lam+2G) e_yy, and
+/// s_yy = (lam+2G) e_yy + lam e_xx = 4G(lam+G)/(lam+2G) e_yy.
+/// The top reaction is s_yy times the 1 m width (1e-9 relative: a linear field is exact).
+#[test]
+fn smooth_platens_give_the_uniaxial_plane_strain_answer() {
+    let mut model = panel(-0.01);
+    model.loading = Loading::compression(-0.01, 0.0, Platens::Smooth);
+    let mut solver = Solver::new(model, SolverSettings { steps: 2, ..Default::default() }).unwrap();
+    let m = elastic();
+    solver.run(&mut m.clone(), &mut ()).unwrap();
+    let (l, g) = (m.lambda, m.shear);
+    let syy = 4.0 * g * (l + g) / (l + 2.0 * g) * (-0.01);
+    let top = solver.reactions()["top"][1];
+    assert!((top - syy).abs() < 1e-9 * syy.abs(), "{top} vs {syy}");
 }

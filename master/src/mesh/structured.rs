@@ -9,7 +9,7 @@ impl Mesh {
     /// elements of `kind`.
     ///
     /// Named sets (nodes and edges): `bottom` (y = y0), `right`, `top`, `left`; node sets
-    /// `all`. Nodes are numbered row by row from the bottom-left on the (2 nx + 1) x
+    /// `all` and the corners `bottom_left`, `bottom_right`, `top_left`, `top_right`. Nodes are numbered row by row from the bottom-left on the (2 nx + 1) x
     /// (2 ny + 1) grid (Q8 skips element centres); elements row by row.
     pub fn rectangle(
         kind: ElementKind,
@@ -86,6 +86,10 @@ impl Mesh {
         desc.edge_groups.insert("left".into(), left);
         desc.edge_groups.insert("right".into(), right);
         desc.node_groups.insert("all".into(), (0..desc.nodes.len()).collect());
+        desc.node_groups.insert("bottom_left".into(), vec![g(0, 0)]);
+        desc.node_groups.insert("bottom_right".into(), vec![g(gx - 1, 0)]);
+        desc.node_groups.insert("top_left".into(), vec![g(0, gy - 1)]);
+        desc.node_groups.insert("top_right".into(), vec![g(gx - 1, gy - 1)]);
         Mesh::from_description(desc)
     }
 }

@@ -106,7 +106,34 @@ impl LoadVectors {
     }
 }
 
+/// Platen friction in the compression scenes (THEORY.md section 4).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum Platens {
+    /// `u_x = 0` on top and bottom (the default).
+    Rough,
+    /// `u_x` free on top and bottom, except at the `bottom_left` node (no rigid translation).
+    Smooth,
+}
+
 impl Loading {
+    /// Compression between platens: `u_y = bottom_uy` on `bottom`, `u_y = top_uy` on `top`
+    /// at the end of the loading (e.g. `top_uy = -d`, `bottom_uy = 0`), `w` free. With
+    /// [`Platens::Smooth`] the mesh needs a `bottom_left` node set (structured meshes have one).
+    pub fn compression(top_uy: f64, bottom_uy: f64, platens: Platens) -> Self {
+        let mut dirichlet = vec![
+            Dirichlet::new("bottom", Component::Uy, bottom_uy),
+            Dirichlet::new("top", Component::Uy, top_uy),
+        ];
+        match platens {
+            Platens::Rough => {
+                dirichlet.push(Dirichlet::new("bottom", Component::Ux, 0.0));
+                dirichlet.push(Dirichlet::new("top", Component::Ux, 0.0));
+            }
+            Platens::Smooth => dirichlet.push(Dirichlet::new("bottom_left", Component::Ux, 0.0)),
+        }
+        Self { dirichlet, ..Default::default() }
+    }
+
     /// Which dofs are prescribed and to what, before the dof map exists.
     pub fn prescribed(&self, mesh: &Mesh, field: Field) -> Result<(Vec<bool>, Vec<f64>)> {
         let ndf = field.ndf();

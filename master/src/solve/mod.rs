@@ -7,6 +7,8 @@ mod newton;
 mod observer;
 
 pub use linear::LinearSolver;
-pub use loading::{BodyLoad, Dirichlet, EdgeLoad, EdgeLoadKind, LoadVectors, Loading, Ramp};
+pub use loading::{
+    BodyLoad, Dirichlet, EdgeLoad, EdgeLoadKind, LoadVectors, Loading, Platens, Ramp,
+};
 pub use newton::{IterationTiming, Model, RunSummary, Solver, SolverSettings};
 pub use observer::{GaussPointState, SolutionView, StepObserver, StepReport};

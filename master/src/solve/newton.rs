@@ -152,7 +152,7 @@ impl Failure {
 }
 
 enum Attempt {
-    Converged { iterations: u32, residuals: Vec<f64> },
+    Converged { iterations: u32, residuals: Vec<f64>, halvings: u32 },
     Failed(Failure),
 }
 
@@ -289,7 +289,7 @@ impl Solver {
             let span = tracing::info_span!("load_step", step, lambda = target);
             let _enter = span.enter();
             match self.attempt(material, step, &mut iteration, target)? {
-                Attempt::Converged { iterations, residuals } => {
+                Attempt::Converged { iterations, residuals, halvings } => {
                     material.commit(step)?;
                     let done = target - self.lambda;
                     self.lambda = target;
@@ -300,6 +300,7 @@ impl Solver {
                         increment: done,
                         iterations,
                         residuals,
+                        line_search_halvings: halvings,
                         cuts,
                         reactions: self.reactions.clone(),
                     };
@@ -438,6 +439,7 @@ impl Solver {
         let mut residuals = Vec::new();
         let mut previous: Option<(Vec<f64>, f64)> = None; // (u before the update, |r| there)
         let mut last_rel = f64::INFINITY;
+        let mut halvings = 0;
         for k in 1..=self.settings.max_iterations + 1 {
             let span = tracing::info_span!("newton", iteration = k);
             let _enter = span.enter();
@@ -465,6 +467,7 @@ impl Solver {
                     break (responses, asm, r, scale);
                 }
                 alpha *= 0.5;
+                halvings += 1;
                 let (u_prev, _) = previous.as_ref().expect("grows implies a previous iterate");
                 u.clone_from(u_prev);
                 self.add_free(&mut u, &du, alpha);
@@ -487,7 +490,7 @@ impl Solver {
             if by_force || by_displacement {
                 self.accept(u, &responses, &asm.f_int, &f_ext);
                 self.committed = Some(responses);
-                return Ok(Attempt::Converged { iterations: k, residuals });
+                return Ok(Attempt::Converged { iterations: k, residuals, halvings });
             }
             if k > self.settings.max_iterations {
                 break;

@@ -19,6 +19,8 @@ pub struct StepReport {
     pub iterations: u32,
     /// Relative force residual after the predictor and after each iteration.
     pub residuals: Vec<f64>,
+    /// Line-search halvings taken in the successful attempt.
+    pub line_search_halvings: u32,
     /// Failed attempts (step cuts) before this step converged.
     pub cuts: u32,
     /// Reaction `[R_x, R_y, R_w]` (N, N, N m per metre of thickness) of every named node set:
