@@ -10,7 +10,7 @@ use super::linear::LinearSolver;
 use super::loading::{LoadVectors, Loading};
 use super::observer::{GaussPointState, SolutionView, StepObserver, StepReport};
 use crate::assembly::{CosseratOperator, DofMap, Field, GaussData, Pattern};
-use crate::element::QuadratureRule;
+use crate::element::{ElementKind, QuadratureRule};
 use crate::error::{Error, Result};
 use crate::material::{Material, MaterialError, TrialId};
 use crate::mesh::Mesh;
@@ -189,6 +189,11 @@ impl Solver {
     /// Sets up the discrete system: dofs, Gauss data, load vectors and sparsity pattern.
     pub fn new(model: Model, settings: SolverSettings) -> Result<Self> {
         settings.check()?;
+        if model.mesh.kind == ElementKind::Q9 && model.rule == QuadratureRule::Gauss2x2 {
+            // Unlike Q8's, the zero-energy modes of 2x2-integrated Q9 elements can spread
+            // through a mesh.
+            tracing::warn!("Q9 elements with 2x2 Gauss points have communicable spurious modes");
+        }
         let (prescribed, _) = model.loading.prescribed(&model.mesh, model.field)?;
         let dofs = DofMap::new(model.field, model.mesh.n_nodes(), &prescribed);
         let gauss = GaussData::new(&model.mesh, model.rule)?;
