@@ -6,6 +6,14 @@
 
 use cosdem_common::{GaussPointId, MacroDeformation, MicroResponse};
 
+mod elastic;
+mod failing;
+mod softening;
+
+pub use elastic::ElasticCosserat;
+pub use failing::FailureInjector;
+pub use softening::SofteningElastic;
+
 /// Identifies one trial evaluation: load step and Newton iteration within it.
 ///
 /// Workers use it to answer retries idempotently: the same id always gets the same answer.

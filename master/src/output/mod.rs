@@ -124,25 +124,8 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     result
 }
 
-/// The equivalent strain of Eq. 34 for one Gauss point.
-///
-/// `e = [e_xx, e_yy, e_xy, e_yx, k_x, k_y]` (THEORY section 1), `lc` the internal length.
-/// q = sqrt(1/2 e7^T M e7) with e7 = [d_xx, d_yy, d_zz, e_xy, e_yx, k_x lc, k_y lc], the normal
-/// strains replaced by their deviatoric parts d_ii = e_ii - tr/3 (plane strain: e_zz = 0,
-/// tr = e_xx + e_yy) and M = I3 (+) [[1/2, 1/2], [1/2, 1/2]] (+) I2, so
-/// q^2 = 1/2 (d_xx^2 + d_yy^2 + d_zz^2 + (e_xy + e_yx)^2 / 2 + lc^2 (k_x^2 + k_y^2)).
-pub fn equivalent_strain(e: &[f64; 6], lc: f64) -> f64 {
-    let tr = e[0] + e[1];
-    let d = [e[0] - tr / 3.0, e[1] - tr / 3.0, -tr / 3.0];
-    let shear = e[2] + e[3];
-    let q2 = 0.5
-        * (d[0] * d[0]
-            + d[1] * d[1]
-            + d[2] * d[2]
-            + 0.5 * shear * shear
-            + lc * lc * (e[4] * e[4] + e[5] * e[5]));
-    q2.sqrt()
-}
+/// The equivalent strain of Eq. 34, defined once in [`crate::post`].
+pub use crate::post::equivalent_strain;
 
 #[cfg(test)]
 mod tests {
@@ -186,24 +169,6 @@ mod tests {
                 assert_eq!(fmt_f64(v).parse::<f64>().unwrap().to_bits(), v.to_bits());
             }
         }
-    }
-
-    #[test]
-    fn equivalent_strain_closed_forms() {
-        // Pure shear e_xy = e_yx = g/2 (symmetric, no rotation): q^2 = 1/2 * g^2 / 2.
-        let g = 0.02;
-        let q = equivalent_strain(&[0.0, 0.0, g / 2.0, g / 2.0, 0.0, 0.0], 0.1);
-        assert!((q - (g * g / 4.0).sqrt()).abs() < 1e-15);
-        // Skew part (e_xy = -e_yx, a relative rotation) does not count.
-        assert_eq!(equivalent_strain(&[0.0, 0.0, 0.3, -0.3, 0.0, 0.0], 1.0), 0.0);
-        // Uniaxial e_xx = a: d = (2a/3, -a/3, -a/3), q^2 = 1/2 * 6a^2/9 = a^2/3.
-        let a = 1e-3;
-        let q = equivalent_strain(&[a, 0.0, 0.0, 0.0, 0.0, 0.0], 0.0);
-        assert!((q - a / 3f64.sqrt()).abs() < 1e-18);
-        // Curvature scaled by lc: q = lc |k| / sqrt(2).
-        let q = equivalent_strain(&[0.0, 0.0, 0.0, 0.0, 3.0, 4.0], 0.01);
-        assert!((q - 0.05 / 2f64.sqrt()).abs() < 1e-15);
-        assert_eq!(equivalent_strain(&[0.0; 6], 1.0), 0.0);
     }
 
     #[test]

@@ -1,0 +1,98 @@
+//! The one error type of the master crate.
+
+use crate::material::MaterialError;
+use cosdem_common::GaussPointId;
+
+/// Result alias of the master crate.
+pub type Result<T> = std::result::Result<T, Error>;
+
+/// Everything that can go wrong in meshing, assembly and the nonlinear solve.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// A mesh description is inconsistent (bad node index, wrong node count, ...).
+    #[error("invalid mesh: {field} = {value}: {reason}")]
+    InvalidMesh {
+        /// Which part of the description.
+        field: &'static str,
+        /// The offending value.
+        value: String,
+        /// Why it is invalid.
+        reason: String,
+    },
+    /// A named node or edge set does not exist in the mesh.
+    #[error("unknown {kind} set `{name}` (known: {known})")]
+    UnknownSet {
+        /// `node` or `edge`.
+        kind: &'static str,
+        /// The requested name.
+        name: String,
+        /// The names the mesh has.
+        known: String,
+    },
+    /// An element maps to a non-positive area at a quadrature point.
+    #[error("element {element}: Jacobian determinant {det_j} <= 0 at reference point {xi:?}")]
+    InvertedElement {
+        /// Element index.
+        element: usize,
+        /// The determinant found.
+        det_j: f64,
+        /// Reference coordinates of the point.
+        xi: [f64; 2],
+    },
+    /// A solver or load setting is out of range.
+    #[error("invalid setting {field} = {value}: {reason}")]
+    InvalidSetting {
+        /// Setting name.
+        field: &'static str,
+        /// The offending value.
+        value: String,
+        /// The allowed range.
+        reason: String,
+    },
+    /// The material answered with the wrong number of responses.
+    #[error("material returned {got} responses for {expected} gauss points")]
+    ResponseCount {
+        /// Responses expected (one per Gauss point).
+        expected: usize,
+        /// Responses received.
+        got: usize,
+    },
+    /// The material cannot be reached at all (no step cutting helps).
+    #[error("material error: {0}")]
+    Material(#[from] MaterialError),
+    /// The sparse linear solver failed outside the Newton loop (symbolic analysis, memory).
+    #[error("linear solver: {0}")]
+    LinearSolver(String),
+    /// The load increment was cut below the minimum and the step still fails.
+    #[error(
+        "load step {step} failed from load factor {load_factor:.6e} with increment \
+         {increment:.3e}, and halving it would go below the minimum {min_increment:.3e}: \
+         {reason}{}",
+        describe_points(gauss_points)
+    )]
+    StepTooSmall {
+        /// Load step being solved.
+        step: u64,
+        /// Last converged load factor.
+        load_factor: f64,
+        /// Increment of the last failed attempt.
+        increment: f64,
+        /// The minimum increment allowed.
+        min_increment: f64,
+        /// Why the last attempt failed.
+        reason: String,
+        /// Gauss points that failed in the last attempt (empty for a pure divergence).
+        gauss_points: Vec<(GaussPointId, String)>,
+    },
+    /// An observer refused a converged step (e.g. output failed).
+    #[error("step observer: {0}")]
+    Observer(String),
+}
+
+fn describe_points(points: &[(GaussPointId, String)]) -> String {
+    if points.is_empty() {
+        return String::new();
+    }
+    let list: Vec<String> = points.iter().map(|(id, why)| format!("{id} ({why})")).collect();
+    format!("; failed gauss points: {}", list.join(", "))
+}

@@ -1,0 +1,14 @@
+//! The nonlinear solve: loading, sparse linear solves, Newton-Raphson with line search and
+//! load-step cutting, and the per-step observer.
+
+mod linear;
+mod loading;
+mod newton;
+mod observer;
+
+pub use linear::LinearSolver;
+pub use loading::{
+    BodyLoad, Dirichlet, EdgeLoad, EdgeLoadKind, LoadVectors, Loading, Platens, Ramp,
+};
+pub use newton::{IterationTiming, Model, RunSummary, Solver, SolverSettings};
+pub use observer::{GaussPointState, SolutionView, StepObserver, StepReport};

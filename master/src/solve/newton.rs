@@ -1,0 +1,591 @@
+//! The driver: setup once, then load steps of Newton-Raphson iterations with line search and
+//! automatic load-step cutting (THEORY.md section 3).
+//!
+//! Life cycle, deal.II style: [`Solver::new`] sets up the system (dof numbering, Gauss data,
+//! load vectors, sparsity pattern; the symbolic factorization follows on the first solve),
+//! [`Solver::run`] loops over load steps; each step is a predictor plus Newton iterations,
+//! then `commit`, reactions and the observer call.
+
+use super::linear::LinearSolver;
+use super::loading::{LoadVectors, Loading};
+use super::observer::{GaussPointState, SolutionView, StepObserver, StepReport};
+use crate::assembly::{CosseratOperator, DofMap, Field, GaussData, Pattern};
+use crate::element::{ElementKind, QuadratureRule};
+use crate::error::{Error, Result};
+use crate::material::{Material, MaterialError, TrialId};
+use crate::mesh::Mesh;
+use cosdem_common::{GaussPointId, MicroResponse};
+use std::collections::BTreeMap;
+
+/// What is solved: mesh, field, integration rule and loading.
+#[derive(Clone, Debug)]
+pub struct Model {
+    /// The mesh.
+    pub mesh: Mesh,
+    /// Cosserat or Cauchy continuum.
+    pub field: Field,
+    /// Gauss rule (the paper: 2x2 on Q8).
+    pub rule: QuadratureRule,
+    /// Boundary conditions and loads.
+    pub loading: Loading,
+}
+
+/// Newton-Raphson and step-control parameters.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SolverSettings {
+    /// Nominal number of equal load steps from `lambda = 0` to 1.
+    pub steps: usize,
+    /// Newton iterations allowed per attempt before the step is cut.
+    pub max_iterations: u32,
+    /// Force criterion: `|r_free| <= force_tolerance * max(|f_int|, |f_ext|)`.
+    pub force_tolerance: f64,
+    /// Displacement criterion: `|du| <= displacement_tolerance * |u - u_n|` (the step's
+    /// accumulated increment). Either criterion ends the iteration (the paper's section 3).
+    pub displacement_tolerance: f64,
+    /// Backtrack (halve the update) while the residual norm grows.
+    pub line_search: bool,
+    /// Halvings allowed per line search.
+    pub max_line_search: u32,
+    /// Smallest increment as a fraction of the nominal `1 / steps`; a step that still fails
+    /// below it ends the run with [`Error::StepTooSmall`].
+    pub min_increment_fraction: f64,
+    /// A step converged within this many iterations lets the increment grow.
+    pub easy_iterations: u32,
+    /// Growth factor of the increment after an easy step (capped at the nominal increment).
+    pub growth: f64,
+}
+
+impl Default for SolverSettings {
+    fn default() -> Self {
+        Self {
+            steps: 10,
+            max_iterations: 25,
+            force_tolerance: 1e-8,
+            // Tight by default so that the force criterion decides on smooth problems; the
+            // paper's looser displacement criterion is a job-file choice.
+            displacement_tolerance: 1e-12,
+            line_search: true,
+            max_line_search: 5,
+            // 1/1024: ten halvings of the nominal increment.
+            min_increment_fraction: 1.0 / 1024.0,
+            easy_iterations: 4,
+            growth: 2.0,
+        }
+    }
+}
+
+impl SolverSettings {
+    /// Number of nominal steps that moves a boundary by `total` in increments of at most
+    /// `increment` (for jobs that give a displacement increment instead of a step count).
+    pub fn steps_for_increment(total: f64, increment: f64) -> Result<usize> {
+        if !(increment.abs() > 0.0 && increment.is_finite() && total.is_finite()) {
+            return Err(Error::InvalidSetting {
+                field: "increment",
+                value: increment.to_string(),
+                reason: "must be finite and non-zero".into(),
+            });
+        }
+        Ok(((total / increment).abs() - 1e-9).ceil().max(1.0) as usize)
+    }
+
+    fn check(&self) -> Result<()> {
+        let bad = |field: &'static str, value: String, reason: &str| {
+            Err(Error::InvalidSetting { field, value, reason: reason.into() })
+        };
+        if self.steps == 0 {
+            return bad("steps", "0".into(), "must be >= 1");
+        }
+        if self.max_iterations == 0 {
+            return bad("max_iterations", "0".into(), "must be >= 1");
+        }
+        if !(self.force_tolerance >= 0.0 && self.displacement_tolerance >= 0.0) {
+            return bad("tolerances", format!("{self:?}"), "must be >= 0");
+        }
+        if !(self.min_increment_fraction > 0.0 && self.min_increment_fraction <= 1.0) {
+            return bad(
+                "min_increment_fraction",
+                self.min_increment_fraction.to_string(),
+                "in (0, 1]",
+            );
+        }
+        if self.growth.is_nan() || self.growth < 1.0 {
+            return bad("growth", self.growth.to_string(), "must be >= 1");
+        }
+        Ok(())
+    }
+}
+
+/// The whole run's step reports.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RunSummary {
+    /// One report per converged step.
+    pub steps: Vec<StepReport>,
+}
+
+/// Why one attempt at a load step failed (the step is then cut).
+#[derive(Debug)]
+enum Failure {
+    Material(Vec<(GaussPointId, String)>),
+    NotFinite(Vec<(GaussPointId, String)>),
+    Singular(String),
+    MaxIterations(u32, f64),
+}
+
+impl Failure {
+    fn reason(&self) -> String {
+        match self {
+            Self::Material(p) => format!("material failed at {} gauss point(s)", p.len()),
+            Self::NotFinite(p) => format!("non-finite response at {} gauss point(s)", p.len()),
+            Self::Singular(s) => format!("linear solve failed: {s}"),
+            Self::MaxIterations(n, r) => {
+                format!("no convergence in {n} iterations (relative residual {r:.3e})")
+            }
+        }
+    }
+
+    fn points(self) -> Vec<(GaussPointId, String)> {
+        match self {
+            Self::Material(p) | Self::NotFinite(p) => p,
+            _ => Vec::new(),
+        }
+    }
+}
+
+enum Attempt {
+    Converged { iterations: u32, residuals: Vec<f64>, halvings: u32 },
+    Failed(Failure),
+}
+
+/// The macro solver: owns the model, the discrete system and the converged state.
+pub struct Solver {
+    model: Model,
+    settings: SolverSettings,
+    operator: CosseratOperator,
+    dofs: DofMap,
+    gauss: GaussData,
+    pattern: Pattern,
+    linear: LinearSolver,
+    loads: LoadVectors,
+    values: Vec<f64>,
+    /// Converged nodal dofs (all dofs).
+    u: Vec<f64>,
+    /// Converged load factor.
+    lambda: f64,
+    /// Converged steps so far.
+    step: u64,
+    /// Responses at the converged state (the next predictor's tangent), if known.
+    committed: Option<Vec<MicroResponse>>,
+    /// Gauss-point states at the converged state.
+    states: Vec<GaussPointState>,
+    /// Reactions at the converged state.
+    reactions: BTreeMap<String, [f64; 3]>,
+}
+
+fn norm(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+impl Solver {
+    /// Sets up the discrete system: dofs, Gauss data, load vectors and sparsity pattern.
+    pub fn new(model: Model, settings: SolverSettings) -> Result<Self> {
+        settings.check()?;
+        if model.mesh.kind == ElementKind::Q9 && model.rule == QuadratureRule::Gauss2x2 {
+            // Unlike Q8's, the zero-energy modes of 2x2-integrated Q9 elements can spread
+            // through a mesh.
+            tracing::warn!("Q9 elements with 2x2 Gauss points have communicable spurious modes");
+        }
+        let (prescribed, _) = model.loading.prescribed(&model.mesh, model.field)?;
+        let dofs = DofMap::new(model.field, model.mesh.n_nodes(), &prescribed);
+        let gauss = GaussData::new(&model.mesh, model.rule)?;
+        let loads = model.loading.vectors(&model.mesh, &dofs, &gauss)?;
+        let pattern = Pattern::new(&model.mesh, &dofs);
+        let linear = LinearSolver::new(&pattern)?;
+        let states = (0..gauss.len())
+            .map(|g| GaussPointState {
+                id: gauss.id(g),
+                position: gauss.x[g],
+                strain: [0.0; 6],
+                stress: [0.0; 6],
+                diagnostics: Default::default(),
+            })
+            .collect();
+        tracing::info!(
+            nodes = model.mesh.n_nodes(),
+            elements = model.mesh.n_elements(),
+            free_dofs = dofs.n_free,
+            nnz = pattern.nnz(),
+            gauss_points = gauss.len(),
+            "system set up"
+        );
+        Ok(Self {
+            operator: CosseratOperator { field: model.field },
+            values: vec![0.0; pattern.nnz()],
+            u: vec![0.0; dofs.n_dofs()],
+            model,
+            settings,
+            dofs,
+            gauss,
+            pattern,
+            linear,
+            loads,
+            lambda: 0.0,
+            step: 0,
+            committed: None,
+            states,
+            reactions: BTreeMap::new(),
+        })
+    }
+
+    /// The model.
+    pub fn model(&self) -> &Model {
+        &self.model
+    }
+
+    /// The dof numbering.
+    pub fn dofs(&self) -> &DofMap {
+        &self.dofs
+    }
+
+    /// The mapped Gauss points.
+    pub fn gauss(&self) -> &GaussData {
+        &self.gauss
+    }
+
+    /// The sparsity pattern of the free-dof tangent.
+    pub fn pattern(&self) -> &Pattern {
+        &self.pattern
+    }
+
+    /// Converged load factor.
+    pub fn load_factor(&self) -> f64 {
+        self.lambda
+    }
+
+    /// The converged solution.
+    pub fn solution(&self) -> SolutionView<'_> {
+        SolutionView {
+            mesh: &self.model.mesh,
+            field: self.model.field,
+            dofs: &self.u,
+            gauss_points: &self.states,
+        }
+    }
+
+    /// Reactions of every named node set at the converged state.
+    pub fn reactions(&self) -> &BTreeMap<String, [f64; 3]> {
+        &self.reactions
+    }
+
+    /// Runs all load steps to `lambda = 1`, calling `observer` after each converged step.
+    pub fn run(
+        &mut self,
+        material: &mut dyn Material,
+        observer: &mut dyn StepObserver,
+    ) -> Result<RunSummary> {
+        let nominal = 1.0 / self.settings.steps as f64;
+        let min_increment = nominal * self.settings.min_increment_fraction;
+        let mut increment = nominal;
+        let mut summary = RunSummary::default();
+        let mut cuts = 0u32;
+        let mut iteration = 0u32; // TrialId.iteration: keeps counting across cuts
+        while self.lambda < 1.0 - 1e-12 {
+            let target = (self.lambda + increment).min(1.0);
+            let step = self.step + 1;
+            let span = tracing::info_span!("load_step", step, lambda = target);
+            let _enter = span.enter();
+            match self.attempt(material, step, &mut iteration, target)? {
+                Attempt::Converged { iterations, residuals, halvings } => {
+                    material.commit(step)?;
+                    let done = target - self.lambda;
+                    self.lambda = target;
+                    self.step = step;
+                    let report = StepReport {
+                        step,
+                        load_factor: target,
+                        increment: done,
+                        iterations,
+                        residuals,
+                        line_search_halvings: halvings,
+                        cuts,
+                        reactions: self.reactions.clone(),
+                    };
+                    tracing::info!(iterations, cuts, "step converged");
+                    observer.on_step(&report, &self.solution())?;
+                    summary.steps.push(report);
+                    cuts = 0;
+                    iteration = 0;
+                    if iterations <= self.settings.easy_iterations {
+                        increment = (done * self.settings.growth).min(nominal);
+                    }
+                }
+                Attempt::Failed(failure) => {
+                    material.rollback()?;
+                    let tried = target - self.lambda;
+                    tracing::warn!(
+                        reason = failure.reason(),
+                        increment = tried,
+                        "cutting the step"
+                    );
+                    cuts += 1;
+                    increment = 0.5 * tried;
+                    if increment < min_increment * (1.0 - 1e-9) {
+                        return Err(Error::StepTooSmall {
+                            step,
+                            load_factor: self.lambda,
+                            increment: tried,
+                            min_increment,
+                            reason: failure.reason(),
+                            gauss_points: failure.points(),
+                        });
+                    }
+                }
+            }
+        }
+        Ok(summary)
+    }
+
+    /// Evaluates the material at `u`; material failures become [`Failure`]s.
+    fn evaluate(
+        &self,
+        material: &mut dyn Material,
+        trial: TrialId,
+        u: &[f64],
+    ) -> Result<std::result::Result<Vec<MicroResponse>, Failure>> {
+        let inputs = self.operator.kinematics(&self.model.mesh, &self.gauss, u);
+        match material.evaluate(trial, &inputs) {
+            Ok(r) if r.len() != inputs.len() => {
+                Err(Error::ResponseCount { expected: inputs.len(), got: r.len() })
+            }
+            Ok(r) => {
+                let bad: Vec<_> = r
+                    .iter()
+                    .zip(&inputs)
+                    .filter(|(r, _)| !r.is_finite())
+                    .map(|(_, i)| (i.gauss_point, "non-finite stress or tangent".to_string()))
+                    .collect();
+                if bad.is_empty() { Ok(Ok(r)) } else { Ok(Err(Failure::NotFinite(bad))) }
+            }
+            Err(MaterialError::GaussPoints(p)) => Ok(Err(Failure::Material(p))),
+            Err(e @ MaterialError::Unavailable(_)) => Err(e.into()),
+        }
+    }
+
+    /// Residual on the free dofs and the force scale of the convergence criterion.
+    fn residual(&self, f_int: &[f64], f_ext: &[f64]) -> (Vec<f64>, f64) {
+        let mut r = vec![0.0; self.dofs.n_free];
+        for (d, &eq) in self.dofs.equation.iter().enumerate() {
+            if eq != usize::MAX {
+                r[eq] = f_int[d] - f_ext[d];
+            }
+        }
+        let scale = norm(f_int).max(norm(f_ext));
+        (r, scale)
+    }
+
+    /// One attempt at reaching load factor `target` from the converged state.
+    fn attempt(
+        &mut self,
+        material: &mut dyn Material,
+        step: u64,
+        iteration: &mut u32,
+        target: f64,
+    ) -> Result<Attempt> {
+        let symmetric = material.is_symmetric();
+        let f_ext = self.loads.f_ext(target);
+        let du_c: Vec<f64> = self
+            .loads
+            .prescribed_value
+            .iter()
+            .zip(&self.u)
+            .zip(&self.loads.prescribed)
+            .map(|((v, u), &p)| if p { target * v - u } else { 0.0 })
+            .collect();
+        let next_trial = |it: &mut u32| {
+            let t = TrialId { step, iteration: *it };
+            *it += 1;
+            t
+        };
+
+        // Predictor: tangent at the converged state, Dirichlet increment through -K_fc du_c.
+        let responses = match self.committed.take() {
+            Some(r) => r,
+            None => match self.evaluate(material, next_trial(iteration), &self.u)? {
+                Ok(r) => r,
+                Err(f) => return Ok(Attempt::Failed(f)),
+            },
+        };
+        let (mesh, dofs, gauss, pattern) =
+            (&self.model.mesh, &self.dofs, &self.gauss, &self.pattern);
+        let asm = self.operator.assemble(
+            mesh,
+            dofs,
+            gauss,
+            pattern,
+            &responses,
+            Some(&mut self.values),
+            Some(&du_c),
+        );
+        self.committed = Some(responses);
+        let (r0, _) = self.residual(&asm.f_int, &f_ext);
+        let mut rhs: Vec<f64> = r0.iter().zip(&asm.k_fc_du).map(|(r, k)| -(r + k)).collect();
+        if let Err(s) = {
+            let _s = tracing::info_span!("predictor").entered();
+            self.linear.solve(&self.values, &mut rhs, symmetric)
+        } {
+            return Ok(Attempt::Failed(Failure::Singular(s)));
+        }
+        let u_n = self.u.clone();
+        let mut u = u_n.clone();
+        self.add_free(&mut u, &rhs, 1.0);
+        for (x, d) in u.iter_mut().zip(&du_c) {
+            *x += d;
+        }
+        let mut du = rhs;
+        let mut residuals = Vec::new();
+        let mut previous: Option<(Vec<f64>, f64)> = None; // (u before the update, |r| there)
+        let mut last_rel = f64::INFINITY;
+        let mut halvings = 0;
+        for k in 1..=self.settings.max_iterations + 1 {
+            let span = tracing::info_span!("newton", iteration = k);
+            let _enter = span.enter();
+            let mut alpha = 1.0;
+            let (responses, asm, r, scale) = loop {
+                let responses = match self.evaluate(material, next_trial(iteration), &u)? {
+                    Ok(r) => r,
+                    Err(f) => return Ok(Attempt::Failed(f)),
+                };
+                let asm = self.operator.assemble(
+                    &self.model.mesh,
+                    &self.dofs,
+                    &self.gauss,
+                    &self.pattern,
+                    &responses,
+                    Some(&mut self.values),
+                    None,
+                );
+                let (r, scale) = self.residual(&asm.f_int, &f_ext);
+                let grows = previous.as_ref().is_some_and(|(_, rp)| norm(&r) > *rp);
+                let can_cut = self.settings.line_search
+                    && grows
+                    && alpha > 0.5f64.powi(self.settings.max_line_search as i32);
+                if !can_cut {
+                    break (responses, asm, r, scale);
+                }
+                alpha *= 0.5;
+                halvings += 1;
+                let (u_prev, _) = previous.as_ref().expect("grows implies a previous iterate");
+                u.clone_from(u_prev);
+                self.add_free(&mut u, &du, alpha);
+                tracing::debug!(alpha, "line search");
+            };
+            let rn = norm(&r);
+            if !rn.is_finite() {
+                return Ok(Attempt::Failed(Failure::Singular("residual not finite".into())));
+            }
+            let rel = if scale > 0.0 { rn / scale } else { 0.0 };
+            residuals.push(rel);
+            last_rel = rel;
+            let step_norm: f64 =
+                u.iter().zip(&u_n).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt();
+            let du_norm = alpha * norm(&du);
+            tracing::debug!(relative_residual = rel, du = du_norm, "iteration");
+            let by_force = rel <= self.settings.force_tolerance;
+            let by_displacement =
+                k > 1 && du_norm <= self.settings.displacement_tolerance * step_norm;
+            if by_force || by_displacement {
+                self.accept(u, &responses, &asm.f_int, &f_ext);
+                self.committed = Some(responses);
+                return Ok(Attempt::Converged { iterations: k, residuals, halvings });
+            }
+            if k > self.settings.max_iterations {
+                break;
+            }
+            let mut rhs: Vec<f64> = r.iter().map(|x| -x).collect();
+            if let Err(s) = self.linear.solve(&self.values, &mut rhs, symmetric) {
+                return Ok(Attempt::Failed(Failure::Singular(s)));
+            }
+            previous = Some((u.clone(), rn));
+            self.add_free(&mut u, &rhs, 1.0);
+            du = rhs;
+        }
+        Ok(Attempt::Failed(Failure::MaxIterations(self.settings.max_iterations, last_rel)))
+    }
+
+    /// `u[free] += alpha * du[eq]`.
+    fn add_free(&self, u: &mut [f64], du: &[f64], alpha: f64) {
+        for (d, &eq) in self.dofs.equation.iter().enumerate() {
+            if eq != usize::MAX {
+                u[d] += alpha * du[eq];
+            }
+        }
+    }
+
+    /// Stores the converged state: dofs, Gauss-point states, reactions.
+    fn accept(&mut self, u: Vec<f64>, responses: &[MicroResponse], f_int: &[f64], f_ext: &[f64]) {
+        let inputs = self.operator.kinematics(&self.model.mesh, &self.gauss, &u);
+        for ((s, i), r) in self.states.iter_mut().zip(&inputs).zip(responses) {
+            s.strain = i.deformation.strain();
+            s.stress = r.stress;
+            s.diagnostics = r.diagnostics.clone();
+        }
+        let ndf = self.dofs.field.ndf();
+        self.reactions = self
+            .model
+            .mesh
+            .node_sets
+            .iter()
+            .map(|(name, nodes)| {
+                let mut sum = [0.0; 3];
+                for &n in nodes {
+                    for c in 0..ndf {
+                        sum[c] += f_int[n * ndf + c] - f_ext[n * ndf + c];
+                    }
+                }
+                (name.clone(), sum)
+            })
+            .collect();
+        self.u = u;
+    }
+
+    /// One Newton iteration's work at the converged state, for benchmarks: material
+    /// evaluation, assembly of residual and tangent, numeric factorization and solve.
+    pub fn iteration_work(&mut self, material: &mut dyn Material) -> Result<IterationTiming> {
+        let symmetric = material.is_symmetric();
+        let t = std::time::Instant::now();
+        let trial = TrialId { step: self.step + 1, iteration: 0 };
+        let responses = match self.evaluate(material, trial, &self.u)? {
+            Ok(r) => r,
+            Err(f) => return Err(Error::LinearSolver(f.reason())),
+        };
+        let material_s = t.elapsed().as_secs_f64();
+        let t = std::time::Instant::now();
+        let asm = self.operator.assemble(
+            &self.model.mesh,
+            &self.dofs,
+            &self.gauss,
+            &self.pattern,
+            &responses,
+            Some(&mut self.values),
+            None,
+        );
+        let f_ext = self.loads.f_ext(1.0);
+        let (r, _) = self.residual(&asm.f_int, &f_ext);
+        let assembly_s = t.elapsed().as_secs_f64();
+        let t = std::time::Instant::now();
+        let mut rhs: Vec<f64> = r.iter().map(|x| -x).collect();
+        self.linear.solve(&self.values, &mut rhs, symmetric).map_err(Error::LinearSolver)?;
+        Ok(IterationTiming { material_s, assembly_s, solve_s: t.elapsed().as_secs_f64() })
+    }
+}
+
+/// Wall time of the parts of one Newton iteration (see [`Solver::iteration_work`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct IterationTiming {
+    /// Kinematics and material evaluation (s).
+    pub material_s: f64,
+    /// Residual and tangent assembly (s).
+    pub assembly_s: f64,
+    /// Numeric factorization and triangular solves (s; the first call includes the symbolic
+    /// analysis).
+    pub solve_s: f64,
+}
