@@ -72,13 +72,13 @@ if [[ -z "$bin_dir" ]]; then
         rm -f "$log"
     fi
 fi
-bin_dir="$(cd "$bin_dir" && pwd)"
 for b in cosdem cosdem-worker; do
     [[ -x "$bin_dir/$b" ]] || die "$bin_dir/$b is missing: the release binaries do not exist yet" \
         "(they come with the master and worker CLIs; build with" \
         "'cargo build --release -p cosdem-master -p cosdem-worker')"
 done
 [[ -f "$job" ]] || die "job file not found: $job"
+bin_dir="$(cd "$bin_dir" && pwd)"
 
 tmp="$(mktemp -d "${TMPDIR:-/tmp}/cosdem-compose-test.XXXXXX")"
 project="cosdemtest$$"
