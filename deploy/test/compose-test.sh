@@ -17,7 +17,7 @@
 # curve.csv, fields.pvd and every vtk/*.vtu with the reference byte for byte.
 # K1 and K2 default to 1/3 and 2/3 of the reference's line count (env COSDEM_TEST_K1/K2).
 # COSDEM_TEST_VERBOSE=1 prints the master's log and the containers' states at the end.
-# Every wait is bounded (COSDEM_TEST_TIMEOUT seconds for the run, default 900); the
+# Every wait is bounded (COSDEM_TEST_TIMEOUT seconds for each run, default 600); the
 # compose project is torn down (`down -v`) on exit. Prints SKIP and exits 0 when no
 # Docker engine answers. Quiet on success but for one closing line.
 set -euo pipefail
@@ -30,7 +30,7 @@ bin_dir=""
 job="$repo/examples/quick.toml"
 tag="local"
 build=1
-run_timeout="${COSDEM_TEST_TIMEOUT:-900}"
+run_timeout="${COSDEM_TEST_TIMEOUT:-600}"
 
 while [[ $# -gt 0 ]]; do
     case "$1" in
