@@ -16,14 +16,17 @@ bin_dir=""
 job="$repo/examples/quick.toml"
 while [[ $# -gt 0 ]]; do
     case "$1" in
-        --bin-dir) bin_dir="$(cd "$2" && pwd)"; shift 2 ;;
+        --bin-dir) bin_dir="$2"; shift 2 ;;
         --job) job="$2"; shift 2 ;;
         *) echo "slurm-test.sh: unknown argument: $1" >&2; exit 2 ;;
     esac
 done
 die() { echo "slurm-test: FAIL: $*" >&2; exit 1; }
 [[ -n "$bin_dir" ]] || die "--bin-dir is required"
+[[ -x "$bin_dir/cosdem" && -x "$bin_dir/cosdem-worker" ]] || die "cosdem or cosdem-worker missing in $bin_dir"
 [[ -f "$job" ]] || die "job file not found: $job"
+bin_dir="$(cd "$bin_dir" && pwd)"
+job="$(cd "$(dirname "$job")" && pwd)/$(basename "$job")"
 
 tmp="$(mktemp -d "${TMPDIR:-/tmp}/cosdem-slurm-test.XXXXXX")"
 trap 'rm -rf "$tmp"' EXIT
