@@ -1,0 +1,206 @@
+#!/usr/bin/env bash
+# The deployment test: cosdem in containers, with a worker killed and another cut off
+# from the network during steps, must give results byte-identical to an in-process run.
+#
+#   deploy/test/compose-test.sh [--bin-dir DIR] [--job FILE] [--tag TAG] [--no-build]
+#
+#   --bin-dir DIR  where cosdem and cosdem-worker are (default: target/release, built
+#                  first with `cargo build --release --locked -p cosdem-master -p cosdem-worker`
+#                  unless --no-build)
+#   --job FILE     the job file (default: examples/quick.toml)
+#   --tag TAG      image tag to build and run (default: local)
+#
+# Steps: build the images (deploy/images/build-images.sh); run the in-process reference
+# `cosdem run JOB --out REF`; bring up deploy/compose/compose.yaml (3 workers, 1 master)
+# with a fresh random token; when curve.csv has K1 lines, `docker kill` worker-1; when it
+# has K2 lines, `docker network disconnect` worker-2; wait for the master; compare
+# curve.csv, fields.pvd and every vtk/*.vtu with the reference byte for byte.
+# K1 and K2 default to 1/3 and 2/3 of the reference's line count (env COSDEM_TEST_K1/K2).
+# COSDEM_TEST_VERBOSE=1 prints the master's log and the containers' states at the end.
+# Every wait is bounded (COSDEM_TEST_TIMEOUT seconds for each run, default 600); the
+# compose project is torn down (`down -v`) on exit. Prints SKIP and exits 0 when no
+# Docker engine answers. Quiet on success but for one closing line.
+set -euo pipefail
+
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+repo="$(cd "$here/../.." && pwd)"
+compose_file="$repo/deploy/compose/compose.yaml"
+
+bin_dir=""
+job="$repo/examples/quick.toml"
+tag="local"
+build=1
+run_timeout="${COSDEM_TEST_TIMEOUT:-600}"
+
+while [[ $# -gt 0 ]]; do
+    case "$1" in
+        --bin-dir) bin_dir="$2"; shift 2 ;;
+        --job) job="$2"; shift 2 ;;
+        --tag) tag="$2"; shift 2 ;;
+        --no-build) build=0; shift ;;
+        -h|--help) sed -n '2,22s/^# \{0,1\}//p' "${BASH_SOURCE[0]}"; exit 0 ;;
+        *) echo "compose-test.sh: unknown argument: $1" >&2; exit 2 ;;
+    esac
+done
+
+say() { echo "compose-test: $*" >&2; }
+die() { say "FAIL: $*"; exit 1; }
+
+if ! docker info >/dev/null 2>&1; then
+    echo "compose-test: SKIP: no Docker engine answers (docker info failed)"
+    exit 0
+fi
+
+if docker compose version >/dev/null 2>&1; then
+    compose=(docker compose)
+elif command -v docker-compose >/dev/null; then
+    compose=(docker-compose)
+else
+    die "neither 'docker compose' nor 'docker-compose' is installed"
+fi
+
+if [[ -z "$bin_dir" ]]; then
+    bin_dir="$repo/target/release"
+    if [[ "$build" == 1 ]]; then
+        command -v cargo >/dev/null || die "cargo not found (or pass --bin-dir / --no-build)"
+        log="$(mktemp)"
+        if ! (cd "$repo" && cargo build --release --locked -p cosdem-master -p cosdem-worker) >"$log" 2>&1; then
+            cat "$log" >&2
+            rm -f "$log"
+            die "cargo build --release failed"
+        fi
+        rm -f "$log"
+    fi
+fi
+for b in cosdem cosdem-worker; do
+    [[ -x "$bin_dir/$b" ]] || die "$bin_dir/$b is missing: the release binaries do not exist yet" \
+        "(they come with the master and worker CLIs; build with" \
+        "'cargo build --release -p cosdem-master -p cosdem-worker')"
+done
+[[ -f "$job" ]] || die "job file not found: $job"
+bin_dir="$(cd "$bin_dir" && pwd)"
+
+tmp="$(mktemp -d "${TMPDIR:-/tmp}/cosdem-compose-test.XXXXXX")"
+project="cosdemtest$$"
+compose_up=0
+
+dc() {
+    COSDEM_TAG="$tag" \
+    COSDEM_TOKEN_FILE="$tmp/secret/token" \
+    COSDEM_JOB_DIR="$tmp/job" \
+    COSDEM_JOB="$(basename "$job")" \
+    COSDEM_RUNS="$tmp/runs" \
+    COSDEM_RUN_NAME="run" \
+    COSDEM_WORKER_RESTART="no" \
+        timeout 300 "${compose[@]}" -f "$compose_file" -p "$project" "$@"
+}
+
+cleanup() {
+    local rc=$?
+    if [[ "$compose_up" == 1 ]]; then
+        if [[ "$rc" != 0 ]]; then
+            say "last container logs:"
+            dc logs --no-color --tail 30 >&2 2>&1 || true
+        fi
+        dc down -v --remove-orphans -t 5 >/dev/null 2>&1 || say "warning: compose down failed for project $project"
+    fi
+    rm -rf "$tmp" || true
+    exit "$rc"
+}
+trap cleanup EXIT
+trap 'exit 130' INT TERM
+
+# Inputs for the containers: a random token (the secret; readable by the container's
+# unprivileged user, inside a directory only root can enter), the job file, and a run
+# directory the unprivileged user can write.
+mkdir -p "$tmp/secret" "$tmp/job" "$tmp/runs"
+chmod 0700 "$tmp/secret"
+head -c 32 /dev/urandom | od -An -tx1 | tr -d ' \n' >"$tmp/secret/token"
+chmod 0644 "$tmp/secret/token"
+install -m 0644 "$job" "$tmp/job/"
+chmod 0755 "$tmp" "$tmp/job"
+chmod 0777 "$tmp/runs"
+
+# Images.
+"$repo/deploy/images/build-images.sh" --worker "$bin_dir/cosdem-worker" --master "$bin_dir/cosdem" --tag "$tag"
+
+# The in-process reference.
+if ! timeout "$run_timeout" "$bin_dir/cosdem" run "$job" --out "$tmp/ref" >"$tmp/ref.log" 2>&1; then
+    cat "$tmp/ref.log" >&2
+    die "the in-process reference run failed"
+fi
+[[ -s "$tmp/ref/curve.csv" ]] || die "the reference run wrote no curve.csv"
+total="$(wc -l <"$tmp/ref/curve.csv")"
+k1="${COSDEM_TEST_K1:-$((total / 3))}"
+k2="${COSDEM_TEST_K2:-$((2 * total / 3))}"
+((k1 >= 1)) || k1=1
+((k2 > k1)) || k2=$((k1 + 1))
+((k2 < total)) || die "the job is too short for two faults: curve.csv has $total lines, need more than $k2"
+
+# The deployment.
+compose_up=1
+if ! dc up -d >"$tmp/up.log" 2>&1; then
+    cat "$tmp/up.log" >&2
+    die "compose up failed (workers unhealthy?)"
+fi
+cid() { dc ps -q "$1"; }
+master="$(cid master)"
+w1="$(cid worker-1)"
+w2="$(cid worker-2)"
+[[ -n "$master" && -n "$w1" && -n "$w2" ]] || die "containers not found after compose up"
+network="$(docker network ls -q --filter "label=com.docker.compose.project=$project" \
+    --filter "label=com.docker.compose.network=cosdem")"
+[[ -n "$network" ]] || die "the compose network was not found"
+curve="$tmp/runs/run/curve.csv"
+deadline=$((SECONDS + run_timeout))
+
+running() { [[ "$(docker inspect -f '{{.State.Running}}' "$1")" == true ]]; }
+lines() { if [[ -f "$curve" ]]; then wc -l <"$curve"; else echo 0; fi; }
+
+# Wait until curve.csv has at least N lines while the master still runs.
+wait_lines() {
+    local n="$1"
+    while (($(lines) < n)); do
+        running "$master" || die "the master stopped before curve.csv reached $n lines" \
+            "(exit code $(docker inspect -f '{{.State.ExitCode}}' "$master"))"
+        ((SECONDS < deadline)) || die "timeout: curve.csv did not reach $n lines in ${run_timeout}s"
+        sleep 0.2
+    done
+    running "$master" || die "the master finished before the fault at line $n could be injected (job too short)"
+}
+
+wait_lines "$k1"
+docker kill "$w1" >/dev/null
+wait_lines "$k2"
+docker network disconnect -f "$network" "$w2" >/dev/null
+
+while running "$master"; do
+    ((SECONDS < deadline)) || die "timeout: the master did not finish in ${run_timeout}s"
+    sleep 1
+done
+code="$(docker inspect -f '{{.State.ExitCode}}' "$master")"
+[[ "$code" == 0 ]] || die "the master exited with code $code"
+! running "$w1" || die "worker-1 is running again after docker kill (restart policy?)"
+
+# Byte-identical results.
+out="$tmp/runs/run"
+cmp "$tmp/ref/curve.csv" "$out/curve.csv" || die "curve.csv differs from the in-process run"
+if [[ -f "$tmp/ref/fields.pvd" ]]; then
+    cmp "$tmp/ref/fields.pvd" "$out/fields.pvd" || die "fields.pvd differs from the in-process run"
+fi
+ref_vtu="$(cd "$tmp/ref" && find vtk -name '*.vtu' 2>/dev/null | sort)"
+out_vtu="$(cd "$out" && find vtk -name '*.vtu' 2>/dev/null | sort)"
+[[ "$ref_vtu" == "$out_vtu" ]] || die "the sets of vtk/*.vtu files differ"
+nvtu=0
+while IFS= read -r f; do
+    [[ -n "$f" ]] || continue
+    cmp "$tmp/ref/$f" "$out/$f" || die "$f differs from the in-process run"
+    nvtu=$((nvtu + 1))
+done <<<"$ref_vtu"
+
+if [[ "${COSDEM_TEST_VERBOSE:-0}" == 1 ]]; then
+    dc logs --no-color master >&2 2>&1 || true
+    docker ps -a --filter "label=com.docker.compose.project=$project" >&2
+fi
+echo "compose-test: OK: $total curve.csv lines and $nvtu .vtu files byte-identical to the in-process run," \
+    "with worker-1 killed after line $k1 and worker-2 disconnected after line $k2"
