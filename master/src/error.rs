@@ -39,6 +39,14 @@ pub enum Error {
         /// Reference coordinates of the point.
         xi: [f64; 2],
     },
+    /// A job file cannot be read or parsed (the message has the line, column and key).
+    #[error("job file {file}: {message}")]
+    JobFile {
+        /// The file (or the origin given to the parser).
+        file: String,
+        /// What went wrong.
+        message: String,
+    },
     /// A solver or load setting is out of range.
     #[error("invalid setting {field} = {value}: {reason}")]
     InvalidSetting {

@@ -41,6 +41,8 @@ pub mod element;
 pub mod error;
 /// Reading input files (Gmsh meshes) into plain data.
 pub mod io;
+/// The job file: schema, validation, conversion into the solver's types.
+pub mod job;
 /// The constitutive operator at the Gauss points: the trait the FE solver talks to.
 pub mod material;
 /// The macro mesh: structured rectangles and the generic raw-description constructor.

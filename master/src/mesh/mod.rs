@@ -192,3 +192,28 @@ impl Mesh {
         })
     }
 }
+
+impl From<crate::io::gmsh::RawMesh> for MeshDescription {
+    /// A Gmsh mesh as read by [`crate::io::gmsh`]: quadrilaterals, node groups and 3-node
+    /// boundary lines (edges of other lengths are not boundary edges of quadratic elements
+    /// and are left to the node groups).
+    fn from(raw: crate::io::gmsh::RawMesh) -> Self {
+        let edge_groups = raw
+            .edge_groups
+            .into_iter()
+            .map(|(name, edges)| {
+                let edges = edges
+                    .into_iter()
+                    .filter_map(|e| <[usize; 3]>::try_from(e.as_slice()).ok())
+                    .collect();
+                (name, edges)
+            })
+            .collect();
+        Self {
+            nodes: raw.nodes,
+            elements: raw.elements.into_iter().map(|e| e.nodes).collect(),
+            node_groups: raw.node_groups,
+            edge_groups,
+        }
+    }
+}
