@@ -38,12 +38,34 @@ pub struct Snapshot {
     pub boundary: Vec<u32>,
 }
 
+/// The binary part of the encoding (everything but the spec).
+#[derive(Serialize, Deserialize)]
+struct Body {
+    law: crate::contact::Law,
+    refc: super::Reference,
+    dt: f64,
+    committed: super::State,
+    trial: Option<super::State>,
+}
+
 impl Assembly {
-    /// Encodes spec, reference, committed and trial state (bincode 2, f64 bit patterns).
+    /// Encodes spec, reference, committed and trial state: the header `CDEMASM1`, the spec
+    /// as length-prefixed JSON (its tagged enums need a self-describing format), then the
+    /// state in bincode 2 (f64 as raw little-endian bit patterns: bit-exact).
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut out = MAGIC.to_vec();
-        // Encoding plain data into a Vec cannot fail.
-        let body = bincode::serde::encode_to_vec(self, bincode::config::standard())
+        // Encoding plain data into memory cannot fail.
+        let spec = serde_json::to_vec(&self.spec).expect("encoding a spec into memory");
+        out.extend_from_slice(&(spec.len() as u64).to_le_bytes());
+        out.extend_from_slice(&spec);
+        let body = Body {
+            law: self.law,
+            refc: self.refc.clone(),
+            dt: self.dt,
+            committed: self.committed.clone(),
+            trial: self.trial.clone(),
+        };
+        let body = bincode::serde::encode_to_vec(&body, bincode::config::standard())
             .expect("encoding an assembly into memory");
         out.extend_from_slice(&body);
         out
@@ -51,20 +73,57 @@ impl Assembly {
 
     /// Restores an assembly encoded by [`Assembly::to_bytes`], bit for bit.
     pub fn from_bytes(bytes: &[u8]) -> Result<Assembly> {
-        if bytes.len() < MAGIC.len() || &bytes[..MAGIC.len()] != MAGIC {
+        let m = MAGIC.len();
+        if bytes.len() < m + 8 || &bytes[..m] != MAGIC {
             return Err(Error::Decode("missing CDEMASM1 header".into()));
         }
-        let (a, used): (Assembly, usize) =
-            bincode::serde::decode_from_slice(&bytes[MAGIC.len()..], bincode::config::standard())
-                .map_err(|e| Error::Decode(e.to_string()))?;
-        if used + MAGIC.len() != bytes.len() {
+        let len = u64::from_le_bytes(bytes[m..m + 8].try_into().expect("8 bytes")) as usize;
+        let rest = &bytes[m + 8..];
+        if len > rest.len() {
             return Err(Error::Decode(format!(
-                "{} trailing bytes",
-                bytes.len() - used - MAGIC.len()
+                "spec length {len} beyond the {} bytes left",
+                rest.len()
             )));
         }
-        a.spec.validate()?;
-        Ok(a)
+        let spec: crate::spec::AssemblySpec =
+            serde_json::from_slice(&rest[..len]).map_err(|e| Error::Decode(e.to_string()))?;
+        spec.validate()?;
+        let (body, used): (Body, usize) =
+            bincode::serde::decode_from_slice(&rest[len..], bincode::config::standard())
+                .map_err(|e| Error::Decode(e.to_string()))?;
+        if len + used != rest.len() {
+            return Err(Error::Decode(format!("{} trailing bytes", rest.len() - len - used)));
+        }
+        let n = body.refc.r.len();
+        let ok = |st: &super::State| {
+            let d = &st.dynamics;
+            let p = &st.pairs;
+            [&d.x, &d.y, &d.th, &d.vx, &d.vy, &d.w].iter().all(|v| v.len() == n)
+                && p.i.iter().chain(&p.j).all(|&k| (k as usize) < n)
+                && p.i.len() == p.fs.len()
+                && p.j.len() == p.fs.len()
+                && p.hr.len() == p.fs.len()
+                && p.xb.len() == n
+                && p.yb.len() == n
+                && (p.ox.is_empty() || p.ox.len() == p.fs.len())
+                && p.oy.len() == p.ox.len()
+        };
+        let refc = &body.refc;
+        let sizes =
+            [&refc.inv_m, &refc.inv_i, &refc.x0, &refc.y0, &refc.th0].iter().all(|v| v.len() == n)
+                && refc.boundary.iter().all(|&k| (k as usize) < n);
+        if !sizes || !ok(&body.committed) || !body.trial.as_ref().is_none_or(ok) {
+            return Err(Error::Decode("inconsistent array sizes".into()));
+        }
+        Ok(Assembly {
+            spec,
+            law: body.law,
+            refc: body.refc,
+            dt: body.dt,
+            committed: body.committed,
+            trial: body.trial,
+            work: Default::default(),
+        })
     }
 
     /// Positions, radii, rotations, contact forces and fluctuation field.

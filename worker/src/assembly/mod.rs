@@ -63,7 +63,7 @@ pub struct State {
 }
 
 /// A disc assembly backing one Gauss point.
-#[derive(Clone, Debug, Serialize, Deserialize)]
+#[derive(Clone, Debug)]
 pub struct Assembly {
     spec: AssemblySpec,
     law: Law,
@@ -71,7 +71,6 @@ pub struct Assembly {
     dt: f64,
     committed: State,
     trial: Option<State>,
-    #[serde(skip)]
     work: Work,
 }
 
