@@ -21,7 +21,7 @@ pub struct Rate {
 /// Hexagonal assembly of radius 5 mm with about `n` discs, default contact law.
 pub fn hexagonal(n: usize) -> Result<Assembly> {
     let r = 0.005;
-    let side = (n as f64 * 2.0 * 3f64.sqrt() * r * r).sqrt();
+    let side = (n as f64 * 2.0 * 3f64.sqrt() * r * r).sqrt() + 2.0 * r;
     let spec =
         AssemblySpec { packing: PackingSpec::Hexagonal { radius: r, side }, ..Default::default() };
     Assembly::new(&spec)

@@ -101,3 +101,38 @@ fn perturbation_tangent_matches_contact_tangent() {
     let sym = |c: &[[f64; 6]; 6]| c[XY][XY] + c[XY][YX];
     assert!(rel(sym(q), sym(p)) < 0.02, "{} vs {}", sym(q), sym(p));
 }
+
+/// The kinetic-energy criterion and warm starts reach the same equilibrium as the default
+/// (unbalanced force, cold start): stresses within 1e-3 relative (both criteria stop at
+/// their own tolerance), and a warm-started second Newton iteration takes fewer steps.
+#[test]
+fn kinetic_criterion_and_warm_start() {
+    let t1 = grad([[-1.2e-3, 0.0], [0.0, -1e-3]]);
+    let t2 = grad([[-1.25e-3, 0.0], [0.0, -1e-3]]);
+    let mut base = Assembly::new(&hex_spec(0.15, penalty())).unwrap();
+    let r_base = base.solve(&t2).unwrap();
+    let mut spec = hex_spec(0.15, penalty());
+    spec.relaxation.criterion = cosdem_worker::Criterion::KineticEnergy;
+    spec.relaxation.tolerance = 1e-8;
+    let mut a = Assembly::new(&spec).unwrap();
+    let r = a.solve(&t2).unwrap();
+    assert!(r.diagnostics.converged);
+    assert!(
+        rel(r.stress[XX], r_base.stress[XX]) < 1e-3,
+        "{} vs {}",
+        r.stress[XX],
+        r_base.stress[XX]
+    );
+    let mut spec = hex_spec(0.15, penalty());
+    spec.warm_start = true;
+    let mut w = Assembly::new(&spec).unwrap();
+    w.solve(&t1).unwrap();
+    let rw = w.solve(&t2).unwrap();
+    assert!(rel(rw.stress[XX], r_base.stress[XX]) < 1e-3);
+    assert!(
+        rw.diagnostics.steps < r_base.diagnostics.steps,
+        "{} vs {}",
+        rw.diagnostics.steps,
+        r_base.diagnostics.steps
+    );
+}

@@ -19,16 +19,11 @@ pub fn advance(
     let (vx, vy, w) = (&mut d.vx[..n], &mut d.vy[..n], &mut d.w[..n]);
     let (fx, fy, tq) = (&work.fx[..n], &work.fy[..n], &work.tq[..n]);
     let (inv_m, inv_i, xb, yb) = (&inv_m[..n], &inv_i[..n], &xb[..n], &yb[..n]);
+    // Branch-free: sign(F v) in {-1, 0, 1} from two comparisons.
     let damp = |f: f64, v: f64| -> f64 {
         let s = f * v;
-        let g = if s > 0.0 {
-            1.0 - alpha
-        } else if s < 0.0 {
-            1.0 + alpha
-        } else {
-            1.0
-        };
-        f * g
+        let sign = (s > 0.0) as i32 - (s < 0.0) as i32;
+        f * (-alpha).mul_add(sign as f64, 1.0)
     };
     let mut m = 0.0f64;
     for k in 0..n {
