@@ -233,6 +233,7 @@ impl Assembly {
                 &st.pairs.yb,
                 0.0,
                 dt,
+                integrate::rebuild_limit2(&sys),
             );
             if let Some((vx, vy, w)) = vold {
                 let mut k = 0.0;

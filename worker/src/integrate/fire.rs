@@ -37,8 +37,8 @@ impl Fire {
         }
     }
 
-    /// One FIRE step; returns the largest squared displacement since the last build and the
-    /// step used (the histories must advance by it).
+    /// One FIRE step; returns whether a disc moved farther than `sqrt(lim2)` since the last
+    /// build, and the step used (the histories must advance by it).
     pub fn advance(
         &mut self,
         d: &mut Dynamics,
@@ -47,7 +47,8 @@ impl Fire {
         inv_i: &[f64],
         xb: &[f64],
         yb: &[f64],
-    ) -> (f64, f64) {
+        lim2: f64,
+    ) -> (bool, f64) {
         let n = d.x.len();
         let dt = self.dt;
         let (fx, fy, tq) = (&work.fx[..n], &work.fy[..n], &work.tq[..n]);
@@ -86,15 +87,15 @@ impl Fire {
             self.alpha = self.alpha_start;
         }
         let h = self.dt;
-        let mut m = 0.0f64;
+        let mut far = false;
         for k in 0..n {
             d.x[k] = d.vx[k].mul_add(h, d.x[k]);
             d.y[k] = d.vy[k].mul_add(h, d.y[k]);
             d.th[k] = d.w[k].mul_add(h, d.th[k]);
             let dx = d.x[k] - xb[k];
             let dy = d.y[k] - yb[k];
-            m = m.max(dx.mul_add(dx, dy * dy));
+            far |= dx.mul_add(dx, dy * dy) > lim2;
         }
-        (m, h)
+        (far, h)
     }
 }

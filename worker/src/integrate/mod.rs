@@ -187,10 +187,15 @@ pub fn elastic_energy(sys: &System<'_>, d: &Dynamics, pairs: &PairList) -> f64 {
     e
 }
 
-/// Rebuilds the pair list when a disc moved more than half the skin since the last build.
-pub fn maybe_rebuild(sys: &System<'_>, d: &Dynamics, pairs: &mut PairList, max_disp2: f64) {
-    let half = 0.5 * sys.skin;
-    if max_disp2 > half * half {
+/// Squared rebuild distance: half the skin.
+pub fn rebuild_limit2(sys: &System<'_>) -> f64 {
+    0.25 * sys.skin * sys.skin
+}
+
+/// Rebuilds the pair list when `far` (some disc moved more than half the skin since the last
+/// build).
+pub fn maybe_rebuild(sys: &System<'_>, d: &Dynamics, pairs: &mut PairList, far: bool) {
+    if far {
         *pairs = broadphase::build(&d.x, &d.y, sys.r, sys.skin, sys.domain, pairs);
     }
 }
@@ -247,12 +252,13 @@ pub fn relax(
                 return Ok(RelaxReport { steps: step, ratio, converged: false });
             }
         }
+        let lim2 = rebuild_limit2(sys);
         let (disp2, h) = match fire.as_mut() {
-            None => (
-                cundall::advance(d, work, sys.inv_m, sys.inv_i, &pairs.xb, &pairs.yb, alpha, dt),
-                dt,
-            ),
-            Some(f) => f.advance(d, work, sys.inv_m, sys.inv_i, &pairs.xb, &pairs.yb),
+            None => {
+                let (xb, yb) = (&pairs.xb, &pairs.yb);
+                (cundall::advance(d, work, sys.inv_m, sys.inv_i, xb, yb, alpha, dt, lim2), dt)
+            }
+            Some(f) => f.advance(d, work, sys.inv_m, sys.inv_i, &pairs.xb, &pairs.yb, lim2),
         };
         maybe_rebuild(sys, d, pairs, disp2);
         sums = forces(sys, d, pairs, work, h);
