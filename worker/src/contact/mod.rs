@@ -5,7 +5,7 @@
 //! kernel is monomorphized over "has rolling" and "has dashpots" so a scene without them pays
 //! nothing. Branch vectors run from each centre to the middle of the overlap
 //! (`a_p = r_p - d/2`), which makes the slip rate vanish under a rigid rotation of the pair;
-//! see [`pair`] for the reasoning.
+//! see [`pair`](crate::contact::pair) for the reasoning.
 
 /// Force kernel over a pair list (the hot loop).
 pub mod kernel;
