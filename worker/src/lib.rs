@@ -37,6 +37,9 @@ use rayon::prelude::*;
 
 /// Solves many assemblies in parallel (one rayon task per assembly, never inside one), so the
 /// results do not depend on the thread count.
+///
+/// # Panics
+/// When `assemblies` and `targets` differ in length (a caller bug, not user input).
 pub fn solve_batch(
     assemblies: &mut [Assembly],
     targets: &[MacroDeformation],

@@ -42,7 +42,7 @@ fn secant(boundary: BoundarySpec, side: f64) -> [f64; 3] {
 /// A large (about 950 discs, V = 0.09 m^2) hexagonal assembly under penalty and under
 /// periodic boundaries gives the same elastic (secant) stiffness within 3%, once the penalty
 /// response is measured where the boundary does not reach: interior window, interior strain,
-/// bulk contact density (measured: within 1%).
+/// bulk contact density (measured: 0.6% on C_xxxx, 1.9% on C_yyxx, 0.2% on the shear).
 #[test]
 fn penalty_and_periodic_give_the_same_elastic_tangent() {
     let p = secant(penalty(), 0.3);
