@@ -14,6 +14,23 @@ fn batch() -> (Vec<Assembly>, Vec<MacroDeformation>) {
         v.push(Assembly::new(&hex_spec(side, penalty())).unwrap());
         t.push(grad([[-1e-3 * (k + 1) as f64, 2e-4], [0.0, -5e-4]]));
     }
+    // Random polydisperse packings under both boundaries (built inside the pool too).
+    for (seed, boundary) in [(11, penalty()), (12, cosdem_worker::BoundarySpec::Periodic)] {
+        let spec = cosdem_worker::AssemblySpec {
+            packing: cosdem_worker::PackingSpec::Random {
+                r_min: 0.002,
+                r_max: 0.004,
+                radii: vec![],
+                side: 0.05,
+                seed,
+                confining_stress: 1e5,
+            },
+            boundary,
+            ..Default::default()
+        };
+        v.push(Assembly::new(&spec).unwrap());
+        t.push(grad([[-1e-3, 5e-4], [0.0, -2e-3]]));
+    }
     (v, t)
 }
 
@@ -24,7 +41,8 @@ fn strip(r: &MicroResponse) -> MicroResponse {
     r
 }
 
-/// `solve_batch` on 1 and on 2 rayon threads: identical responses (compared through their
+/// `solve_batch` over four hexagonal and two random assemblies on 1 and on 2 rayon threads:
+/// identical responses (compared through their
 /// f64 bit patterns, via `PartialEq` on the exact values) and identical serialized states.
 #[test]
 fn same_bits_with_one_and_two_threads() {
