@@ -4,6 +4,8 @@
 //! `s_ij = (1/A) sum l_i f_j`, `m_i = (1/A) sum l_i M`,
 //! `C_ijkl = (1/A) sum l_i K_jl l_k` with `K = k_n n n + k_s' t t`, `D_ij = (1/A) sum k_r' l_i l_j`.
 //! Forces are evaluated from the state (spring parts only: dashpots vanish at rest).
+//! A contact is active when the discs overlap or touch within 1e-9 of their radii sum
+//! (THEORY.md: `d >= -tol` for the tangent of a just-touching packing).
 
 use crate::broadphase::PairList;
 use crate::contact::{Law, rolling};
@@ -79,17 +81,21 @@ pub fn for_each_contact(
         }
         let rs = r[i] + r[j];
         let d2 = lx.mul_add(lx, ly * ly);
-        if d2 >= rs * rs {
+        // Just-touching contacts (gap below 1e-9 of the radii sum, e.g. a hexagonal packing
+        // at Fbar = I whose overlaps are +-rounding) count, with zero force, so the tangent of
+        // the reference state does not depend on the sign of a rounding error.
+        let touch = rs * (1.0 + 1e-9);
+        if d2 >= touch * touch {
             continue;
         }
         let ov = rs - d2.sqrt();
-        let fnorm = law.kn * ov;
-        let fs = pairs.fs[k];
-        let mr = pairs.hr[k];
+        let fnorm = (law.kn * ov).max(0.0);
+        let (fs, mr) = if ov > 0.0 { (pairs.fs[k], pairs.hr[k]) } else { (0.0, 0.0) };
         let lim = 1.0 - 1e-9;
-        let sliding = law.ks > 0.0 && fs.abs() >= law.mu_s * fnorm * lim;
-        let rolling_saturated =
-            law.kr > 0.0 && mr.abs() >= law.mu_r * rolling::rstar(r[i], r[j]) * fnorm * lim;
+        let sliding = law.ks > 0.0 && fnorm > 0.0 && fs.abs() >= law.mu_s * fnorm * lim;
+        let rolling_saturated = law.kr > 0.0
+            && fnorm > 0.0
+            && mr.abs() >= law.mu_r * rolling::rstar(r[i], r[j]) * fnorm * lim;
         f(ContactEval { k, lx, ly, fnorm, fs, mr, sliding, rolling_saturated });
     }
 }

@@ -152,3 +152,24 @@ fn antisymmetric_shear_relaxes_interior_rotations() {
     let affine = (r0.tangent[XY][XY] - r0.tangent[XY][YX]) * (-2e-4);
     assert!((skew / affine).abs() < 0.05, "measured {skew} vs affine {affine}");
 }
+
+/// At Fbar = I the hexagonal discs just touch (overlaps are +-rounding): every touching pair
+/// counts as a contact (THEORY.md's `d >= -tol`), so the reference tangent is the closed
+/// form at the counted density (2%, as for the compressed state) and the stress is zero.
+#[test]
+fn just_touching_reference_has_the_full_tangent() {
+    let mut a = Assembly::new(&hex_spec(0.2, penalty())).unwrap();
+    let r = a.solve(&cosdem_common::MacroDeformation::IDENTITY).unwrap();
+    let h = a.homogenized(a.trial().unwrap());
+    let n = a.disc_count() as u32;
+    assert!(
+        r.diagnostics.contacts > 3 * n - 4 * 22,
+        "{} contacts for {n} discs",
+        r.diagnostics.contacts
+    );
+    assert!(r.stress.iter().all(|s| s.abs() < 1e-6));
+    let cf = closed_form(KN, KS, KR, h.fabric.density);
+    assert!(rel(r.tangent[XX][XX], cf[0]) < 0.02);
+    assert!(rel(r.tangent[XY][XY], cf[2]) < 0.02);
+    assert!(rel(r.tangent[KX][KX], cf[4]) < 0.02);
+}
