@@ -3,6 +3,20 @@
 //! Data path: [`spec`] -> [`packing`] -> [`assembly`] (committed / trial state) ->
 //! [`broadphase`] -> [`contact`] -> [`integrate`] (with [`boundary`]) -> [`homogenize`] ->
 //! `MicroResponse`.
+//!
+//! # Readings of THEORY.md fixed here
+//! - Branch vectors to the contact point (`a_p = r_p - d/2`) in the slip rate and torques,
+//!   instead of `r_p`: the printed Eq. 16 gives a spurious slip `-omega d` under a rigid
+//!   rotation and torques that do not balance the force couple (see [`contact::pair`]).
+//! - `kbar . (X_q - X_c)` in Eq. 24 uses reference coordinates: `kbar` is the gradient of the
+//!   micro-rotation over the reference configuration, unchanged by a superposed rigid rotation.
+//! - The closed forms of `C_xyxy` and `C_xyyx` separately assume every disc turns with `wbar`;
+//!   with Eq. 24 only the boundary layer is pinned, so the measured antisymmetric stiffness is
+//!   a few percent of `C_xyxy - C_xyyx` (the symmetric part matches).
+//! - Boundary-average stress uses `x_q - X_c` (origin-independent only at equilibrium).
+//! - Periodic cells ignore `wbar` and `kbar` (see [`boundary::periodic`]).
+//! - Every run starts from rest at the affine image of its start state (the predictor), and
+//!   just-touching contacts (gap < 1e-9 of the radii sum) count in the tangent.
 
 /// One DEM assembly: state, solve, commit/rollback, serialization, snapshots.
 pub mod assembly;
