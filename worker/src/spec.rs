@@ -1,6 +1,30 @@
 //! The assembly specification: what a job file (or the gRPC service) says about one DEM
 //! assembly. Every struct is serde-derived with `deny_unknown_fields`; defaults are the paper's
 //! values (Chu et al. 2015, section 3) unless a comment says otherwise.
+//!
+//! Every field may be omitted (defaults); a full spec in JSON reads:
+//! ```json
+//! {
+//!   "packing": {"kind": "hexagonal", "radius": 0.005, "side": 0.1},
+//!   "contact": {
+//!     "normal": {"model": "linear", "k_n": 6.7e7},
+//!     "tangential": {"model": "coulomb", "k_s": 3.4e7, "mu_s": 0.5, "c_s": 0.0},
+//!     "rolling": {"model": "coulomb", "k_r": 25.0, "mu_r": 0.2, "c_r": 0.0}
+//!   },
+//!   "density": 2650.0,
+//!   "boundary": {"kind": "penalty", "eps_f": 6.7e6, "eps_c": 1000.0},
+//!   "relaxation": {"driver": {"kind": "cundall", "alpha": 0.7}, "criterion": "unbalanced_force",
+//!                  "tolerance": 1e-4, "max_steps": 400000, "check_every": 10, "safety": 0.5,
+//!                  "density_scale": 1.0, "skin": 0.5},
+//!   "tangent": {"kind": "paper"},
+//!   "warm_start": false
+//! }
+//! ```
+//! A random packing: `{"kind": "random", "r_min": 0.004, "r_max": 0.006, "side": 0.1,
+//! "seed": 1, "confining_stress": 1e5}`; a periodic boundary: `{"kind": "periodic"}`; FIRE:
+//! `{"kind": "fire", "alpha_start": 0.1, "f_inc": 1.1, "f_dec": 0.5, "f_alpha": 0.99,
+//! "n_min": 5, "dt_max": 1.8}`; the perturbation tangent: `{"kind": "perturbation",
+//! "strain": 1e-5}`.
 
 use crate::error::{Result, invalid, non_negative, positive};
 use serde::{Deserialize, Serialize};

@@ -79,6 +79,23 @@ fn bad_bytes_and_unknown_fields() {
     .unwrap_err()
     .to_string();
     assert!(e.contains("extra"), "{e}");
+    // The documented example of `spec.rs` parses to the defaults.
+    let doc = r#"{
+      "packing": {"kind": "hexagonal", "radius": 0.005, "side": 0.1},
+      "contact": {
+        "normal": {"model": "linear", "k_n": 6.7e7},
+        "tangential": {"model": "coulomb", "k_s": 3.4e7, "mu_s": 0.5, "c_s": 0.0},
+        "rolling": {"model": "coulomb", "k_r": 25.0, "mu_r": 0.2, "c_r": 0.0}
+      },
+      "density": 2650.0,
+      "boundary": {"kind": "penalty", "eps_f": 6.7e6, "eps_c": 1000.0},
+      "relaxation": {"driver": {"kind": "cundall", "alpha": 0.7}, "criterion": "unbalanced_force",
+                     "tolerance": 1e-4, "max_steps": 400000, "check_every": 10, "safety": 0.5,
+                     "density_scale": 1.0, "skin": 0.5},
+      "tangent": {"kind": "paper"},
+      "warm_start": false
+    }"#;
+    assert_eq!(serde_json::from_str::<AssemblySpec>(doc).unwrap(), AssemblySpec::default());
     // Defaults round-trip through JSON.
     let s = AssemblySpec::default();
     let back: AssemblySpec = serde_json::from_str(&serde_json::to_string(&s).unwrap()).unwrap();
