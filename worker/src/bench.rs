@@ -64,3 +64,23 @@ pub fn relaxation() -> Result<(usize, u64, bool, f64)> {
     let r = a.solve(&target)?;
     Ok((a.disc_count(), r.diagnostics.steps, r.diagnostics.converged, t0.elapsed().as_secs_f64()))
 }
+
+/// Builds a random polydisperse packing (r in [4, 6] mm, 100 kPa, seed 1) of side `side`
+/// with the given boundary: returns (discs, wall seconds).
+pub fn random_build(side: f64, boundary: crate::spec::BoundarySpec) -> Result<(usize, f64)> {
+    let spec = AssemblySpec {
+        packing: PackingSpec::Random {
+            r_min: 0.004,
+            r_max: 0.006,
+            radii: vec![],
+            side,
+            seed: 1,
+            confining_stress: 1e5,
+        },
+        boundary,
+        ..Default::default()
+    };
+    let t0 = Instant::now();
+    let a = Assembly::new(&spec)?;
+    Ok((a.disc_count(), t0.elapsed().as_secs_f64()))
+}

@@ -3,6 +3,7 @@
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
+use cosdem_worker::BoundarySpec;
 
 /// The cosdem DEM worker.
 #[derive(Parser, Debug)]
@@ -49,5 +50,9 @@ fn bench_dem(quick: bool) -> Result<()> {
     println!(
         "relaxation 0.0784 m^2 ({n} discs, e_yy = -1e-3): {steps} steps, converged {conv}, {wall:.3} s"
     );
+    for boundary in [BoundarySpec::default(), BoundarySpec::Periodic] {
+        let (n, wall) = cosdem_worker::bench::random_build(0.28, boundary.clone())?;
+        println!("random packing 0.0784 m^2 ({n} discs, {boundary:?}): built in {wall:.3} s");
+    }
     Ok(())
 }
