@@ -1,6 +1,6 @@
 use super::{Assembly, Reference, State};
 use crate::boundary::penalty::boundary_layer;
-use crate::broadphase::{self, Domain, PairList};
+use crate::broadphase::{self, PairList};
 use crate::contact::Law;
 use crate::error::{Error, Result};
 use crate::integrate::{self, Dynamics, Work, timestep::critical_step};
@@ -126,12 +126,24 @@ fn random_assembly(spec: &AssemblySpec, law: Law) -> Result<Assembly> {
             lam * lam
         )));
     }
-    // Bisection on the cell stretch (from the committed state below the target).
+    // Bisection on the cell stretch (from the committed state below the target). A stage
+    // that hit its step cap is continued (commit, solve the same target again) until it
+    // converges, so a pressure is accepted only at equilibrium.
+    let settle = |a: &mut Assembly, lam: f64| -> Result<f64> {
+        let mut resp = a.solve(&iso(lam))?;
+        for _ in 0..25 {
+            if resp.diagnostics.converged {
+                break;
+            }
+            a.commit();
+            resp = a.solve(&iso(lam))?;
+        }
+        Ok(pressure(&resp.stress))
+    };
     let mut best = lo;
-    for _ in 0..30 {
+    for _ in 0..40 {
         let mid = 0.5 * (lo + hi);
-        let resp = a.solve(&iso(mid))?;
-        let p = pressure(&resp.stress);
+        let p = settle(&mut a, mid)?;
         best = mid;
         if (p - target).abs() <= 0.02 * target {
             break;
@@ -143,7 +155,6 @@ fn random_assembly(spec: &AssemblySpec, law: Law) -> Result<Assembly> {
             hi = mid;
         }
     }
-    a.solve(&iso(best))?;
     a.commit();
     // Stage 2: the compressed periodic configuration becomes the reference.
     let l = best * a.refc.lx;
@@ -167,24 +178,28 @@ fn random_assembly(spec: &AssemblySpec, law: Law) -> Result<Assembly> {
     let mut b = from_packing(spec, law, p);
     if let BoundarySpec::Penalty { eps_f, eps_c } = spec.boundary {
         prestress_reference(&mut b, eps_f, eps_c);
-        // The cut lost the contacts across the cell boundary: bring the square back to the
-        // confining stress by an isotropic stretch (secant iteration on the contact
-        // tangent), then make that state the reference.
-        let mut r = b.solve(&MacroDeformation::IDENTITY)?;
-        let mut e = 0.0;
-        for _ in 0..20 {
-            let p = pressure(&r.stress);
-            if (p - target).abs() <= 0.02 * target {
-                break;
-            }
-            let c = &r.tangent;
-            let k = -0.5 * (c[0][0] + c[0][1] + c[1][0] + c[1][1]);
+    }
+    // With friction switched on and, for a penalty square, the contacts across the cut lost,
+    // the relaxed stress differs from the target: bring it back by an isotropic stretch
+    // (secant iteration on the contact tangent, each solve relaxed to the spec's tolerance),
+    // then make that state the reference.
+    let mut r = b.solve(&MacroDeformation::IDENTITY)?;
+    let mut e = 0.0;
+    for _ in 0..30 {
+        let p = pressure(&r.stress);
+        if r.diagnostics.converged && (p - target).abs() <= 0.02 * target {
+            break;
+        }
+        let c = &r.tangent;
+        // dp/de for Fbar = (1 + e) I (negative: compression raises p).
+        let k = -0.5 * (c[0][0] + c[0][1] + c[1][0] + c[1][1]);
+        if k < 0.0 {
             e += (target - p) / k;
-            r = b.solve(&iso(1.0 + e))?;
         }
-        if e != 0.0 {
-            b = rereference(&b, spec, law, 1.0 + e, eps_f, eps_c);
-        }
+        r = b.solve(&iso(1.0 + e))?;
+    }
+    if e != 0.0 {
+        b = rereference(&b, spec, law, 1.0 + e);
     }
     // Final relaxation at the reference with the full contact law.
     let resp = b.solve(&MacroDeformation::IDENTITY)?;
@@ -201,14 +216,7 @@ fn random_assembly(spec: &AssemblySpec, law: Law) -> Result<Assembly> {
 /// The trial state of `b` (relaxed at `Fbar = lam I`) as a new reference: region scaled by
 /// `lam` about its centre, contact histories kept, penalty rest points placed by
 /// [`prestress_reference`].
-fn rereference(
-    b: &Assembly,
-    spec: &AssemblySpec,
-    law: Law,
-    lam: f64,
-    eps_f: f64,
-    eps_c: f64,
-) -> Assembly {
+fn rereference(b: &Assembly, spec: &AssemblySpec, law: Law, lam: f64) -> Assembly {
     let st = b.trial.as_ref().unwrap_or(&b.committed);
     let (lx, ly) = (lam * b.refc.lx, lam * b.refc.ly);
     let sx = b.refc.xc[0] - 0.5 * lx;
@@ -224,8 +232,11 @@ fn rereference(
     let mut c = from_packing(spec, law, p);
     let skin = spec.relaxation.skin * c.refc.r_min;
     let cd = &c.committed.dynamics;
-    c.committed.pairs = broadphase::build(&cd.x, &cd.y, &c.refc.r, skin, Domain::Open, &st.pairs);
-    prestress_reference(&mut c, eps_f, eps_c);
+    let dom = c.domain(&MacroDeformation::IDENTITY);
+    c.committed.pairs = broadphase::build(&cd.x, &cd.y, &c.refc.r, skin, dom, &st.pairs);
+    if let BoundarySpec::Penalty { eps_f, eps_c } = spec.boundary {
+        prestress_reference(&mut c, eps_f, eps_c);
+    }
     c
 }
 
