@@ -173,3 +173,25 @@ fn just_touching_reference_has_the_full_tangent() {
     assert!(rel(r.tangent[XY][XY], cf[2]) < 0.02);
     assert!(rel(r.tangent[KX][KX], cf[4]) < 0.02);
 }
+
+/// Fluctuation field (Eq. 35, `u_R = u - (Fbar - I)(X - X_c)`): zero to rounding for a
+/// periodic hexagonal cell (the affine field is the equilibrium), and for a penalty assembly
+/// the boundary-layer lag shows up as fluctuations that are a small fraction of the affine
+/// displacement at the edge (measured about 10%: the membrane effect).
+#[test]
+fn fluctuation_field() {
+    let g = grad([[-1.2e-3, 3e-4], [1e-4, -0.8e-3]]);
+    let mut a = Assembly::new(&hex_spec(0.2, BoundarySpec::Periodic)).unwrap();
+    a.solve(&g).unwrap();
+    let s = a.snapshot();
+    let worst = s.fluctuation.iter().map(|u| u[0].hypot(u[1])).fold(0.0, f64::max);
+    assert!(worst < 1e-12, "{worst}");
+    let mut a = Assembly::new(&hex_spec(0.2, penalty())).unwrap();
+    a.solve(&g).unwrap();
+    let s = a.snapshot();
+    let worst = s.fluctuation.iter().map(|u| u[0].hypot(u[1])).fold(0.0, f64::max);
+    let edge = 0.1 * 1.3e-3;
+    assert!(worst > 0.0 && worst < 0.3 * edge, "{worst} vs affine edge displacement {edge}");
+    assert_eq!(s.x.len(), a.disc_count());
+    assert_eq!(s.boundary.len(), a.reference().boundary.len());
+}
