@@ -1,0 +1,264 @@
+use super::{Assembly, Reference, State};
+use crate::boundary::penalty::boundary_layer;
+use crate::broadphase::{self, PairList};
+use crate::contact::Law;
+use crate::error::{Error, Result};
+use crate::integrate::{self, Dynamics, Work, timestep::critical_step};
+use crate::packing::{Packing, hexagonal, random};
+use crate::spec::{AssemblySpec, BoundarySpec, PackingSpec, RollingModel, TangentialModel};
+use cosdem_common::MacroDeformation;
+
+pub(super) fn new(spec: &AssemblySpec) -> Result<Assembly> {
+    spec.validate()?;
+    let law = Law::from_params(&spec.contact);
+    match &spec.packing {
+        PackingSpec::Hexagonal { radius, side } => {
+            let p = match spec.boundary {
+                BoundarySpec::Penalty { .. } => hexagonal::square(*radius, *side),
+                BoundarySpec::Periodic => hexagonal::periodic(*radius, *side),
+            };
+            Ok(from_packing(spec, law, p))
+        }
+        PackingSpec::Random { .. } => random_assembly(spec, law),
+    }
+}
+
+/// An assembly at rest in the reference state of `p` (no histories, identity target).
+pub(super) fn from_packing(spec: &AssemblySpec, law: Law, p: Packing) -> Assembly {
+    let n = p.r.len();
+    let rho = spec.density * spec.relaxation.density_scale;
+    let mut inv_m = Vec::with_capacity(n);
+    let mut inv_i = Vec::with_capacity(n);
+    for &r in &p.r {
+        let m = rho * std::f64::consts::PI * r * r;
+        inv_m.push(1.0 / m);
+        inv_i.push(2.0 / (m * r * r));
+    }
+    let r_min = p.r.iter().fold(f64::MAX, |a, &b| a.min(b));
+    let r_max = p.r.iter().fold(0.0f64, |a, &b| a.max(b));
+    let area = p.area();
+    let (boundary, kf, kc) = match spec.boundary {
+        BoundarySpec::Penalty { eps_f, eps_c } => {
+            (boundary_layer(&p.x, &p.y, p.lx, p.ly, 2.0 * r_max), eps_f / area, eps_c / area)
+        }
+        BoundarySpec::Periodic => (Vec::new(), 0.0, 0.0),
+    };
+    let m_min = rho * std::f64::consts::PI * r_min * r_min;
+    let dt = spec.relaxation.safety
+        * critical_step(&law, m_min, 0.5 * m_min * r_min * r_min, r_min, kf, kc);
+    let refc = Reference {
+        r: p.r.clone(),
+        inv_m,
+        inv_i,
+        x0: p.x.clone(),
+        y0: p.y.clone(),
+        th0: vec![0.0; n],
+        boundary,
+        lx: p.lx,
+        ly: p.ly,
+        xc: [0.5 * p.lx, 0.5 * p.ly],
+        area,
+        r_min,
+        r_max,
+    };
+    let dynamics = Dynamics::at_rest(p.x, p.y);
+    let mut a = Assembly {
+        spec: spec.clone(),
+        law,
+        refc,
+        dt,
+        committed: State {
+            dynamics,
+            pairs: PairList::default(),
+            target: MacroDeformation::IDENTITY,
+        },
+        trial: None,
+        work: Work::default(),
+    };
+    let dom = a.domain(&MacroDeformation::IDENTITY);
+    let skin = spec.relaxation.skin * r_min;
+    let d = &a.committed.dynamics;
+    a.committed.pairs = broadphase::build(&d.x, &d.y, &a.refc.r, skin, dom, &PairList::default());
+    a
+}
+
+/// Random packing (see [`crate::packing::random`]): periodic frictionless compression to the
+/// confining stress, then the real contact law, then the requested boundary.
+fn random_assembly(spec: &AssemblySpec, law: Law) -> Result<Assembly> {
+    let PackingSpec::Random { r_min, r_max, radii, side, seed, confining_stress } = &spec.packing
+    else {
+        unreachable!()
+    };
+    let loose = random::loose(*r_min, *r_max, radii, *side, *seed)?;
+    // Stage 1: frictionless periodic compression.
+    let mut s1 = spec.clone();
+    s1.boundary = BoundarySpec::Periodic;
+    s1.contact.tangential = TangentialModel::None;
+    s1.contact.rolling = RollingModel::None;
+    s1.tangent = crate::spec::TangentKind::Paper;
+    s1.warm_start = false;
+    s1.relaxation.tolerance = 1e-3;
+    s1.relaxation.max_steps = 4_000;
+    // FIRE relaxes the frictionless compression stages several times faster than Cundall.
+    s1.relaxation.driver = crate::spec::Driver::fire();
+    let mut a = from_packing(&s1, Law::from_params(&s1.contact), loose);
+    let pressure = |s: &[f64; 6]| -0.5 * (s[0] + s[1]);
+    let target = *confining_stress;
+    let iso = |l: f64| MacroDeformation { f: [[l, 0.0], [0.0, l]], w: 0.0, kappa: [0.0; 2] };
+    let (mut lo, mut hi) = (1.0f64, 0.0f64); // lo: below target pressure, hi: above
+    let mut lam = 1.0f64;
+    let mut found = false;
+    for _ in 0..400 {
+        lam *= 0.99;
+        let resp = a.solve(&iso(lam))?;
+        let p = pressure(&resp.stress);
+        if p >= target {
+            hi = lam;
+            found = true;
+            break;
+        }
+        a.commit();
+        lo = lam;
+    }
+    if !found {
+        return Err(Error::Packing(format!(
+            "confining stress {target} Pa not reached after compressing to area ratio {:.3}",
+            lam * lam
+        )));
+    }
+    // Bisection on the cell stretch (from the committed state below the target). A stage
+    // that hit its step cap is continued (commit, solve the same target again) until it
+    // converges, so a pressure is accepted only at equilibrium.
+    let settle = |a: &mut Assembly, lam: f64| -> Result<f64> {
+        let mut resp = a.solve(&iso(lam))?;
+        for _ in 0..25 {
+            if resp.diagnostics.converged {
+                break;
+            }
+            a.commit();
+            resp = a.solve(&iso(lam))?;
+        }
+        Ok(pressure(&resp.stress))
+    };
+    let mut best = lo;
+    for _ in 0..40 {
+        let mid = 0.5 * (lo + hi);
+        let p = settle(&mut a, mid)?;
+        best = mid;
+        if (p - target).abs() <= 0.02 * target {
+            break;
+        }
+        if p < target {
+            a.commit();
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    a.commit();
+    // Stage 2: the compressed periodic configuration becomes the reference.
+    let l = best * a.refc.lx;
+    let d = &a.committed.dynamics;
+    let mut p = Packing {
+        x: d.x.clone(),
+        y: d.y.clone(),
+        r: a.refc.r.clone(),
+        lx: l,
+        ly: best * a.refc.ly,
+    };
+    let periodic = matches!(spec.boundary, BoundarySpec::Periodic);
+    if !periodic {
+        // Wrap into [0, lx) x [0, ly): contacts across the cut are dropped below.
+        for k in 0..p.x.len() {
+            p.x[k] -= (p.x[k] / p.lx).floor() * p.lx;
+            p.y[k] -= (p.y[k] / p.ly).floor() * p.ly;
+        }
+    }
+    let _ = l;
+    let mut b = from_packing(spec, law, p);
+    if let BoundarySpec::Penalty { eps_f, eps_c } = spec.boundary {
+        prestress_reference(&mut b, eps_f, eps_c);
+    }
+    // With friction switched on and, for a penalty square, the contacts across the cut lost,
+    // the relaxed stress differs from the target: bring it back by an isotropic stretch
+    // (secant iteration on the contact tangent, each solve relaxed to the spec's tolerance),
+    // then make that state the reference.
+    let mut r = b.solve(&MacroDeformation::IDENTITY)?;
+    let mut e = 0.0;
+    for _ in 0..30 {
+        let p = pressure(&r.stress);
+        if r.diagnostics.converged && (p - target).abs() <= 0.02 * target {
+            break;
+        }
+        let c = &r.tangent;
+        // dp/de for Fbar = (1 + e) I (negative: compression raises p).
+        let k = -0.5 * (c[0][0] + c[0][1] + c[1][0] + c[1][1]);
+        if k < 0.0 {
+            e += (target - p) / k;
+        }
+        r = b.solve(&iso(1.0 + e))?;
+    }
+    if e != 0.0 {
+        b = rereference(&b, spec, law, 1.0 + e);
+    }
+    // Final relaxation at the reference with the full contact law.
+    let resp = b.solve(&MacroDeformation::IDENTITY)?;
+    b.commit();
+    let p_final = pressure(&resp.stress);
+    if p_final.is_nan() || p_final <= 0.0 {
+        return Err(Error::Packing(format!(
+            "final confining stress {p_final} Pa is not compressive"
+        )));
+    }
+    Ok(b)
+}
+
+/// The trial state of `b` (relaxed at `Fbar = lam I`) as a new reference: region scaled by
+/// `lam` about its centre, contact histories kept, penalty rest points placed by
+/// [`prestress_reference`].
+fn rereference(b: &Assembly, spec: &AssemblySpec, law: Law, lam: f64) -> Assembly {
+    let st = b.trial.as_ref().unwrap_or(&b.committed);
+    let (lx, ly) = (lam * b.refc.lx, lam * b.refc.ly);
+    let sx = b.refc.xc[0] - 0.5 * lx;
+    let sy = b.refc.xc[1] - 0.5 * ly;
+    let d = &st.dynamics;
+    let p = Packing {
+        x: d.x.iter().map(|v| v - sx).collect(),
+        y: d.y.iter().map(|v| v - sy).collect(),
+        r: b.refc.r.clone(),
+        lx,
+        ly,
+    };
+    let mut c = from_packing(spec, law, p);
+    let skin = spec.relaxation.skin * c.refc.r_min;
+    let cd = &c.committed.dynamics;
+    let dom = c.domain(&MacroDeformation::IDENTITY);
+    c.committed.pairs = broadphase::build(&cd.x, &cd.y, &c.refc.r, skin, dom, &st.pairs);
+    if let BoundarySpec::Penalty { eps_f, eps_c } = spec.boundary {
+        prestress_reference(&mut c, eps_f, eps_c);
+    }
+    c
+}
+
+/// Moves the rest points of the boundary particles' penalty springs so that, at Fbar = I, each
+/// spring balances the net contact force and torque on its particle: `X_q = x_q - (V/eps_f)
+/// f_q`, `th0_q = -(V/eps_c) tau_q`. The prestressed cut packing is then in equilibrium in its
+/// reference state.
+fn prestress_reference(b: &mut Assembly, eps_f: f64, eps_c: f64) {
+    let law = b.law;
+    let sys = b.system(&law, None, &MacroDeformation::IDENTITY);
+    let mut d = b.committed.dynamics.clone();
+    d.stop();
+    let mut pairs = b.committed.pairs.clone();
+    let mut work = Work::default();
+    integrate::forces(&sys, &d, &mut pairs, &mut work, b.dt);
+    let v = b.refc.area;
+    for &q in &b.refc.boundary {
+        let q = q as usize;
+        b.refc.x0[q] = d.x[q] - v / eps_f * work.fx[q];
+        b.refc.y0[q] = d.y[q] - v / eps_f * work.fy[q];
+        if eps_c > 0.0 {
+            b.refc.th0[q] = -v / eps_c * work.tq[q];
+        }
+    }
+}

@@ -1,0 +1,256 @@
+use super::{Assembly, State};
+use crate::boundary::{mat_inv, mat_mul, rotation_angle};
+use crate::broadphase;
+use crate::contact::rolling;
+use crate::error::Result;
+use crate::homogenize::{Homogenized, homogenize};
+use crate::integrate::{self, RelaxReport};
+use crate::spec::{BoundarySpec, TangentKind};
+use cosdem_common::voigt::{KX, KY, N, XX, XY, YX, YY};
+use cosdem_common::{MacroDeformation, MicroDiagnostics, MicroResponse};
+use std::time::Instant;
+
+impl Assembly {
+    /// Trial solve: from the committed state (or the last trial with `warm_start`), jump
+    /// affinely to `target`, relax, homogenize. The trial state is kept for `commit`.
+    pub fn solve(&mut self, target: &MacroDeformation) -> Result<MicroResponse> {
+        target.validate()?;
+        let t0 = Instant::now();
+        let start = match (&self.trial, self.spec.warm_start) {
+            (Some(t), true) => t.clone(),
+            _ => self.committed.clone(),
+        };
+        let tol = self.spec.relaxation.tolerance;
+        let (st, rep) = self.relax_to(start, target, tol)?;
+        let h = self.homogenized(&st);
+        let tangent = match self.spec.tangent {
+            TangentKind::Paper => h.paper,
+            TangentKind::SlidingAware => h.sliding_aware,
+            TangentKind::Perturbation { strain } => self.perturbation_tangent(&st, strain)?,
+        };
+        let diagnostics = MicroDiagnostics {
+            steps: rep.steps,
+            residual_ratio: rep.ratio,
+            converged: rep.converged,
+            contacts: h.fabric.contacts,
+            sliding_fraction: h.fabric.sliding_fraction,
+            rolling_fraction: h.fabric.rolling_fraction,
+            wall_seconds: t0.elapsed().as_secs_f64(),
+        };
+        self.trial = Some(st);
+        Ok(MicroResponse { stress: h.stress, tangent, diagnostics })
+    }
+
+    /// Homogenized stress, tangents and fabric of a state.
+    pub fn homogenized(&self, st: &State) -> Homogenized {
+        let d = &st.dynamics;
+        homogenize(&self.law, &d.x, &d.y, &self.refc.r, &st.pairs, st.target.det() * self.refc.area)
+    }
+
+    /// Jumps `st` affinely to `target` and relaxes it with tolerance `tol`.
+    pub fn relax_to(
+        &mut self,
+        mut st: State,
+        target: &MacroDeformation,
+        tol: f64,
+    ) -> Result<(State, RelaxReport)> {
+        target.validate()?;
+        self.predict(&mut st, target);
+        let mut work = std::mem::take(&mut self.work);
+        let law = self.law;
+        let pen = self.penalty(target);
+        let sys = self.system(&law, pen.as_ref(), target);
+        let rep = integrate::relax(
+            &sys,
+            &mut st.dynamics,
+            &mut st.pairs,
+            &mut work,
+            &self.spec.relaxation,
+            self.dt,
+            tol,
+        );
+        self.work = work;
+        Ok((st, rep?))
+    }
+
+    /// Runs exactly `steps` leapfrog steps towards `target` (no convergence test): the
+    /// benchmark's workload. Returns the steps taken.
+    pub fn run_steps(&mut self, target: &MacroDeformation, steps: u64) -> Result<u64> {
+        target.validate()?;
+        let mut st = self.committed.clone();
+        self.predict(&mut st, target);
+        let mut work = std::mem::take(&mut self.work);
+        let law = self.law;
+        let pen = self.penalty(target);
+        let sys = self.system(&law, pen.as_ref(), target);
+        let mut spec = self.spec.relaxation.clone();
+        spec.max_steps = steps;
+        spec.check_every = u32::MAX;
+        let rep =
+            integrate::relax(&sys, &mut st.dynamics, &mut st.pairs, &mut work, &spec, self.dt, 0.0);
+        self.work = work;
+        let rep = rep?;
+        self.trial = Some(st);
+        Ok(rep.steps.max(steps))
+    }
+
+    /// The affine predictor: every centre is mapped by `dF = F_new F_old^-1` about `X_c`,
+    /// every rotation advanced by the increment of its target rotation (penalty: `wbar +
+    /// kbar . (X_q - X_c)`; periodic: the continuum rotation), and the contact histories by the
+    /// slip and relative rotation of this jump (slip from the exact rotation of the branch
+    /// vector, so a rigid rotation leaves the histories untouched). Velocities are zeroed and
+    /// the pair list rebuilt.
+    fn predict(&self, st: &mut State, target: &MacroDeformation) {
+        let old = st.target;
+        let df = mat_mul(&target.f, &mat_inv(&old.f));
+        let xc = self.refc.xc;
+        let n = self.disc_count();
+        let periodic = matches!(self.spec.boundary, BoundarySpec::Periodic);
+        let dth: Vec<f64> = if periodic {
+            vec![rotation_angle(&target.f) - rotation_angle(&old.f); n]
+        } else {
+            let (dw, dk) = (
+                target.w - old.w,
+                [target.kappa[0] - old.kappa[0], target.kappa[1] - old.kappa[1]],
+            );
+            (0..n)
+                .map(|q| {
+                    dw + dk[0].mul_add(self.refc.x0[q] - xc[0], dk[1] * (self.refc.y0[q] - xc[1]))
+                })
+                .collect()
+        };
+        let law = &self.law;
+        let r = &self.refc.r;
+        let d = &mut st.dynamics;
+        let pl = &mut st.pairs;
+        let per = !pl.ox.is_empty();
+        for k in 0..pl.len() {
+            let (i, j) = (pl.i[k] as usize, pl.j[k] as usize);
+            let mut lx = d.x[j] - d.x[i];
+            let mut ly = d.y[j] - d.y[i];
+            if per {
+                lx += pl.ox[k];
+                ly += pl.oy[k];
+            }
+            let nx = df[0][0].mul_add(lx, df[0][1] * ly);
+            let ny = df[1][0].mul_add(lx, df[1][1] * ly);
+            let len = nx.hypot(ny);
+            let ov = r[i] + r[j] - len;
+            if ov <= 0.0 {
+                pl.fs[k] = 0.0;
+                pl.hr[k] = 0.0;
+                continue;
+            }
+            let dphi = (lx * ny - ly * nx).atan2(lx * nx + ly * ny);
+            let (ai, aj) = (r[i] - 0.5 * ov, r[j] - 0.5 * ov);
+            let ds = (ai + aj) * dphi - (ai * dth[i] + aj * dth[j]);
+            let fnorm = law.kn * ov;
+            let cap = law.mu_s * fnorm;
+            pl.fs[k] = (-law.ks).mul_add(ds, pl.fs[k]).max(-cap).min(cap);
+            if law.has_rolling() {
+                let cap = law.mu_r * rolling::rstar(r[i], r[j]) * fnorm;
+                pl.hr[k] = (-law.kr).mul_add(dth[j] - dth[i], pl.hr[k]).max(-cap).min(cap);
+            }
+        }
+        for q in 0..n {
+            let (px, py) = (d.x[q] - xc[0], d.y[q] - xc[1]);
+            d.x[q] = xc[0] + df[0][0].mul_add(px, df[0][1] * py);
+            d.y[q] = xc[1] + df[1][0].mul_add(px, df[1][1] * py);
+            d.th[q] += dth[q];
+        }
+        d.stop();
+        st.target = *target;
+        let skin = self.spec.relaxation.skin * self.refc.r_min;
+        *pl = broadphase::build(&d.x, &d.y, r, skin, self.domain(target), pl);
+    }
+
+    /// Central-difference tangent: twelve extra relaxations from the equilibrated trial state
+    /// `st` (left untouched), strain perturbation `h`, tolerance 1e-2 of the solve's.
+    fn perturbation_tangent(&mut self, st: &State, h: f64) -> Result<[[f64; N]; N]> {
+        let tol = 1e-2 * self.spec.relaxation.tolerance;
+        let base = st.target;
+        let mut c = [[0.0; N]; N];
+        for col in 0..N {
+            let mut s = [[0.0; N]; 2];
+            for (side, sign) in [(0usize, 1.0f64), (1, -1.0)] {
+                let t = perturbed(&base, col, sign * h);
+                let (pst, _) = self.relax_to(st.clone(), &t, tol)?;
+                s[side] = self.homogenized(&pst).stress;
+            }
+            for row in 0..N {
+                c[row][col] = (s[0][row] - s[1][row]) / (2.0 * h);
+            }
+        }
+        Ok(c)
+    }
+}
+
+/// `base` with Cosserat strain component `col` changed by `h` (micro-rotation fixed).
+pub(crate) fn perturbed(base: &MacroDeformation, col: usize, h: f64) -> MacroDeformation {
+    let mut t = *base;
+    match col {
+        XX => t.f[0][0] += h,
+        YY => t.f[1][1] += h,
+        XY => t.f[1][0] += h,
+        YX => t.f[0][1] += h,
+        KX => t.kappa[0] += h,
+        KY => t.kappa[1] += h,
+        _ => unreachable!(),
+    }
+    t
+}
+
+impl Assembly {
+    /// Plain leapfrog (no damping, no prediction) of `st` for `steps` steps at the base step,
+    /// sampling every `every` steps the leapfrog energy `U(x_n) + sum 1/2 m v_{n-1/2} .
+    /// v_{n+1/2}` (kinetic part with the relaxation masses), which leapfrog conserves exactly
+    /// for quadratic potentials. Returns the samples (the first at step 0).
+    pub fn evolve(&mut self, st: &mut State, steps: u64, every: u64) -> Result<Vec<f64>> {
+        let mut work = std::mem::take(&mut self.work);
+        let law = self.law;
+        let pen = self.penalty(&st.target);
+        let sys = self.system(&law, pen.as_ref(), &st.target);
+        let dt = self.dt;
+        let d = &mut st.dynamics;
+        let mut out = Vec::new();
+        integrate::forces(&sys, d, &mut st.pairs, &mut work, 0.0);
+        for step in 0..steps {
+            let sample = step.is_multiple_of(every.max(1));
+            let (u, vold) = if sample {
+                (
+                    integrate::elastic_energy(&sys, d, &st.pairs),
+                    Some((d.vx.clone(), d.vy.clone(), d.w.clone())),
+                )
+            } else {
+                (0.0, None)
+            };
+            let disp2 = integrate::cundall::advance(
+                d,
+                &work,
+                sys.inv_m,
+                sys.inv_i,
+                &st.pairs.xb,
+                &st.pairs.yb,
+                0.0,
+                dt,
+                integrate::rebuild_limit2(&sys),
+            );
+            if let Some((vx, vy, w)) = vold {
+                let mut k = 0.0;
+                for q in 0..vx.len() {
+                    k += 0.5 * (vx[q] * d.vx[q] + vy[q] * d.vy[q]) / sys.inv_m[q]
+                        + 0.5 * w[q] * d.w[q] / sys.inv_i[q];
+                }
+                out.push(u + k);
+            }
+            integrate::maybe_rebuild(&sys, d, &mut st.pairs, disp2);
+            integrate::forces(&sys, d, &mut st.pairs, &mut work, dt);
+            if !d.is_finite() {
+                self.work = work;
+                return Err(crate::Error::Diverged { steps: step });
+            }
+        }
+        self.work = work;
+        Ok(out)
+    }
+}

@@ -1,0 +1,267 @@
+//! Explicit integration (leapfrog) and the quasi-static relaxation drivers.
+//!
+//! Leapfrog: forces at `x_n` (histories advanced by the displacement `v_{n-1/2} dt`), then
+//! `v_{n+1/2} = v_{n-1/2} + dt F_n / m`, `x_{n+1} = x_n + dt v_{n+1/2}`. The history increments
+//! are exactly the incremental displacements, so below the Coulomb limits the contact springs
+//! are conservative and the scheme is symplectic.
+
+/// Cundall's local non-viscous damping.
+pub mod cundall;
+/// FIRE (fast inertial relaxation engine).
+pub mod fire;
+/// Critical time step from the stiffest oscillator.
+pub mod timestep;
+
+use crate::boundary::penalty::Penalty;
+use crate::broadphase::{self, Domain, PairList};
+use crate::contact::kernel::{self, Accum, Bodies, ContactSums};
+use crate::contact::{Law, rolling};
+use crate::error::{Error, Result};
+use crate::spec::{Criterion, Driver, RelaxationSpec};
+use serde::{Deserialize, Serialize};
+
+/// Disc kinematic state (structure of arrays).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Dynamics {
+    /// Centre x (m).
+    pub x: Vec<f64>,
+    /// Centre y (m).
+    pub y: Vec<f64>,
+    /// Rotation since the reference state (rad).
+    pub th: Vec<f64>,
+    /// Velocity x (m/s).
+    pub vx: Vec<f64>,
+    /// Velocity y (m/s).
+    pub vy: Vec<f64>,
+    /// Spin (rad/s).
+    pub w: Vec<f64>,
+}
+
+impl Dynamics {
+    /// Discs at rest at the given centres.
+    pub fn at_rest(x: Vec<f64>, y: Vec<f64>) -> Self {
+        let n = x.len();
+        Self { x, y, th: vec![0.0; n], vx: vec![0.0; n], vy: vec![0.0; n], w: vec![0.0; n] }
+    }
+
+    /// Sets every velocity and spin to zero.
+    pub fn stop(&mut self) {
+        self.vx.fill(0.0);
+        self.vy.fill(0.0);
+        self.w.fill(0.0);
+    }
+
+    /// True when every entry is finite.
+    pub fn is_finite(&self) -> bool {
+        [&self.x, &self.y, &self.th, &self.vx, &self.vy, &self.w]
+            .iter()
+            .all(|v| v.iter().all(|a| a.is_finite()))
+    }
+}
+
+/// The fixed part of a system: what one relaxation needs besides the state.
+#[derive(Clone, Copy, Debug)]
+pub struct System<'a> {
+    /// Contact law.
+    pub law: &'a Law,
+    /// Radii.
+    pub r: &'a [f64],
+    /// Inverse masses (with density scaling).
+    pub inv_m: &'a [f64],
+    /// Inverse moments of inertia (with density scaling).
+    pub inv_i: &'a [f64],
+    /// Penalty springs (None for periodic).
+    pub penalty: Option<&'a Penalty>,
+    /// Domain for the broad phase.
+    pub domain: Domain,
+    /// Verlet skin (m).
+    pub skin: f64,
+    /// Force scale below which a mean net force counts as zero (N).
+    pub force_floor: f64,
+}
+
+/// Scratch force arrays.
+#[derive(Clone, Debug, Default)]
+pub struct Work {
+    /// Force x.
+    pub fx: Vec<f64>,
+    /// Force y.
+    pub fy: Vec<f64>,
+    /// Torque.
+    pub tq: Vec<f64>,
+}
+
+/// How a relaxation ended.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RelaxReport {
+    /// Steps taken.
+    pub steps: u64,
+    /// Final equilibrium ratio.
+    pub ratio: f64,
+    /// Whether the ratio went below the tolerance.
+    pub converged: bool,
+}
+
+/// Computes all forces at the current state, advancing histories by `v dt`.
+pub fn forces(
+    sys: &System<'_>,
+    d: &Dynamics,
+    pairs: &mut PairList,
+    work: &mut Work,
+    dt: f64,
+) -> ContactSums {
+    let n = d.x.len();
+    work.fx.clear();
+    work.fx.resize(n, 0.0);
+    work.fy.clear();
+    work.fy.resize(n, 0.0);
+    work.tq.clear();
+    work.tq.resize(n, 0.0);
+    let b = Bodies { x: &d.x, y: &d.y, vx: &d.vx, vy: &d.vy, w: &d.w, r: sys.r };
+    let mut acc = Accum { fx: &mut work.fx, fy: &mut work.fy, tq: &mut work.tq };
+    let sums = kernel::accumulate(sys.law, dt, b, pairs, &mut acc);
+    if let Some(p) = sys.penalty {
+        p.apply(&d.x, &d.y, &d.th, &mut work.fx, &mut work.fy, &mut work.tq);
+    }
+    sums
+}
+
+/// Unbalanced-force ratio: mean |net force| over mean contact normal force. With no active
+/// contact the mean penalty force is the reference; a mean net force below `floor` is zero.
+pub fn unbalanced_ratio(sys: &System<'_>, d: &Dynamics, work: &Work, sums: ContactSums) -> f64 {
+    let n = work.fx.len().max(1);
+    let mut net = 0.0;
+    for k in 0..work.fx.len() {
+        net += work.fx[k].hypot(work.fy[k]);
+    }
+    let net = net / n as f64;
+    if net <= sys.force_floor {
+        return 0.0;
+    }
+    let mut reference = if sums.active > 0 { sums.fn_sum / sums.active as f64 } else { 0.0 };
+    if reference <= 0.0
+        && let Some(p) = sys.penalty
+    {
+        let mut s = 0.0;
+        for (k, &q) in p.idx.iter().enumerate() {
+            let q = q as usize;
+            s += (p.kf * (d.x[q] - p.xt[k])).hypot(p.kf * (d.y[q] - p.yt[k]));
+        }
+        reference = s / p.idx.len().max(1) as f64;
+    }
+    if reference > 0.0 { net / reference } else { f64::INFINITY }
+}
+
+/// Kinetic energy (translation + rotation) with the relaxation masses.
+pub fn kinetic_energy(sys: &System<'_>, d: &Dynamics) -> f64 {
+    let mut e = 0.0;
+    for k in 0..d.x.len() {
+        let v2 = d.vx[k].mul_add(d.vx[k], d.vy[k] * d.vy[k]);
+        e += 0.5 * v2 / sys.inv_m[k] + 0.5 * d.w[k] * d.w[k] / sys.inv_i[k];
+    }
+    e
+}
+
+/// Elastic energy stored in contacts (normal, tangential, rolling) and penalty springs.
+pub fn elastic_energy(sys: &System<'_>, d: &Dynamics, pairs: &PairList) -> f64 {
+    let law = sys.law;
+    let mut e = 0.0;
+    for k in 0..pairs.len() {
+        let (i, j) = (pairs.i[k] as usize, pairs.j[k] as usize);
+        let mut dx = d.x[j] - d.x[i];
+        let mut dy = d.y[j] - d.y[i];
+        if !pairs.ox.is_empty() {
+            dx += pairs.ox[k];
+            dy += pairs.oy[k];
+        }
+        let ov = sys.r[i] + sys.r[j] - dx.hypot(dy);
+        if ov > 0.0 {
+            e += crate::contact::normal::energy(law.kn, ov)
+                + crate::contact::tangential::energy(law.ks, pairs.fs[k])
+                + rolling::energy(law.kr, pairs.hr[k]);
+        }
+    }
+    if let Some(p) = sys.penalty {
+        e += p.energy(&d.x, &d.y, &d.th);
+    }
+    e
+}
+
+/// Squared rebuild distance: half the skin.
+pub fn rebuild_limit2(sys: &System<'_>) -> f64 {
+    0.25 * sys.skin * sys.skin
+}
+
+/// Rebuilds the pair list when `far` (some disc moved more than half the skin since the last
+/// build).
+pub fn maybe_rebuild(sys: &System<'_>, d: &Dynamics, pairs: &mut PairList, far: bool) {
+    if far {
+        *pairs = broadphase::build(&d.x, &d.y, sys.r, sys.skin, sys.domain, pairs);
+    }
+}
+
+/// Relaxes `d` to equilibrium with the driver of `spec`, starting with the forces already in
+/// `work` (computed at `d`, with `sums`). Base step `dt`; `tol` overrides the tolerance.
+pub fn relax(
+    sys: &System<'_>,
+    d: &mut Dynamics,
+    pairs: &mut PairList,
+    work: &mut Work,
+    spec: &RelaxationSpec,
+    dt: f64,
+    tol: f64,
+) -> Result<RelaxReport> {
+    let mut sums = forces(sys, d, pairs, work, dt);
+    let ratio_of = |d: &Dynamics, pairs: &PairList, work: &Work, sums: ContactSums| -> f64 {
+        match spec.criterion {
+            Criterion::UnbalancedForce => unbalanced_ratio(sys, d, work, sums),
+            Criterion::KineticEnergy => {
+                let ke = kinetic_energy(sys, d);
+                let el = elastic_energy(sys, d, pairs);
+                if ke == 0.0 {
+                    // At rest: fall back on the force balance so a fresh start is not "done".
+                    unbalanced_ratio(sys, d, work, sums)
+                } else if el > 0.0 {
+                    ke / el
+                } else {
+                    f64::INFINITY
+                }
+            }
+        }
+    };
+    let mut fire = match spec.driver {
+        Driver::Fire { .. } => Some(fire::Fire::new(&spec.driver, dt)),
+        Driver::Cundall { .. } => None,
+    };
+    let alpha = match spec.driver {
+        Driver::Cundall { alpha } => alpha,
+        Driver::Fire { .. } => 0.0,
+    };
+    let check = spec.check_every as u64;
+    let mut step = 0u64;
+    loop {
+        if step.is_multiple_of(check) || step >= spec.max_steps {
+            let ratio = ratio_of(d, pairs, work, sums);
+            if !ratio.is_finite() && !d.is_finite() {
+                return Err(Error::Diverged { steps: step });
+            }
+            if ratio <= tol {
+                return Ok(RelaxReport { steps: step, ratio, converged: true });
+            }
+            if step >= spec.max_steps {
+                return Ok(RelaxReport { steps: step, ratio, converged: false });
+            }
+        }
+        let lim2 = rebuild_limit2(sys);
+        let (disp2, h) = match fire.as_mut() {
+            None => {
+                let (xb, yb) = (&pairs.xb, &pairs.yb);
+                (cundall::advance(d, work, sys.inv_m, sys.inv_i, xb, yb, alpha, dt, lim2), dt)
+            }
+            Some(f) => f.advance(d, work, sys.inv_m, sys.inv_i, &pairs.xb, &pairs.yb, lim2),
+        };
+        maybe_rebuild(sys, d, pairs, disp2);
+        sums = forces(sys, d, pairs, work, h);
+        step += 1;
+    }
+}
