@@ -280,6 +280,13 @@ pub enum MaterialSection {
         /// Internal length lc (m); default 0.01.
         length: Option<f64>,
     },
+    /// A DEM disc assembly at every Gauss point (the paper's two-scale model). The table
+    /// `[material.assembly]` is the worker's assembly spec: packing, contact law, density,
+    /// micro boundary, relaxation and tangent (see the README).
+    Dem {
+        /// The assembly spec, identical at every Gauss point.
+        assembly: Box<cosdem_worker::AssemblySpec>,
+    },
 }
 
 /// `[newton]`: Newton-Raphson and step control. Defaults are [`SolverSettings::default`].
@@ -444,6 +451,9 @@ impl Job {
                     return Err(bad("material.length", lc, "must be finite and >= 0"));
                 }
             }
+            MaterialSection::Dem { assembly } => assembly.validate().map_err(|e| {
+                Error::JobFile { file: "[material.assembly]".into(), message: e.to_string() }
+            })?,
         }
         let n = &self.newton;
         if n.max_iterations == 0 {

@@ -40,3 +40,94 @@ mod tests {
         assert!((q - a / 3f64.sqrt()).abs() < tol);
     }
 }
+
+/// What the paper reads off a load-displacement curve (THEORY.md section 4, scene A).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct CurveMetrics {
+    /// Bearing capacity F_u: the peak load (N per metre of thickness).
+    pub peak_load: f64,
+    /// Displacement at the peak (m).
+    pub peak_displacement: f64,
+    /// Residual capacity F_res: the minimum load after the peak (the plateau minimum);
+    /// `None` while the curve has not passed its peak (the last point is the peak).
+    pub residual_load: Option<f64>,
+    /// Stiffness E: least-squares slope through the origin of the points with displacement
+    /// `<= linear_range` (N/m per metre).
+    pub stiffness: Option<f64>,
+    /// The paper's Fig. 5 stiffness E50 = (F_u / 2) / d50, with d50 the displacement at which
+    /// the load first reaches F_u / 2 (linear interpolation between points).
+    pub stiffness_50: Option<f64>,
+}
+
+impl CurveMetrics {
+    /// Metrics of a curve of `(displacement, load)` points in loading order, starting after
+    /// the origin (the origin `(0, 0)` is implied). `linear_range` is the displacement that
+    /// bounds the linear range (the paper: 0.01 m).
+    pub fn from_curve(curve: &[(f64, f64)], linear_range: f64) -> Self {
+        let Some((ipk, &(dpk, fpk))) =
+            curve.iter().enumerate().max_by(|a, b| a.1.1.total_cmp(&b.1.1))
+        else {
+            return Self::default();
+        };
+        let residual_load = (ipk + 1 < curve.len())
+            .then(|| curve[ipk + 1..].iter().map(|p| p.1).fold(f64::INFINITY, f64::min));
+        let (mut sxy, mut sxx) = (0.0, 0.0);
+        for &(d, f) in curve.iter().filter(|p| p.0 <= linear_range) {
+            sxy += d * f;
+            sxx += d * d;
+        }
+        let stiffness = (sxx > 0.0).then(|| sxy / sxx);
+        let half = 0.5 * fpk;
+        let mut prev = (0.0, 0.0);
+        let mut d50 = None;
+        for &(d, f) in curve {
+            if f >= half {
+                let t = if f > prev.1 { (half - prev.1) / (f - prev.1) } else { 1.0 };
+                d50 = Some(prev.0 + t * (d - prev.0));
+                break;
+            }
+            prev = (d, f);
+        }
+        let stiffness_50 = d50.filter(|d| *d > 0.0).map(|d| half / d);
+        Self { peak_load: fpk, peak_displacement: dpk, residual_load, stiffness, stiffness_50 }
+    }
+}
+
+#[cfg(test)]
+mod curve_tests {
+    use super::CurveMetrics;
+
+    /// A bilinear softening curve with known peak, plateau and slopes; every metric is exact
+    /// up to round-off of a few operations.
+    #[test]
+    fn metrics_of_a_piecewise_linear_curve() {
+        // Rises at 1e6 N/m to 2e4 N at 0.02 m, softens to 1.2e4 N at 0.04 m, then plateau
+        // with a minimum of 1.1e4 N.
+        let mut curve = Vec::new();
+        for i in 1..=20 {
+            let d = 0.001 * i as f64;
+            curve.push((d, 1e6 * d));
+        }
+        for i in 1..=20 {
+            let d = 0.02 + 0.001 * i as f64;
+            curve.push((d, 2e4 - 8e3 * (i as f64 / 20.0)));
+        }
+        curve.push((0.045, 1.1e4));
+        curve.push((0.05, 1.15e4));
+        let m = CurveMetrics::from_curve(&curve, 0.01);
+        assert_eq!(m.peak_load, 2e4);
+        assert!((m.peak_displacement - 0.02).abs() < 1e-15);
+        assert_eq!(m.residual_load, Some(1.1e4));
+        assert!((m.stiffness.unwrap() - 1e6).abs() < 1e-6);
+        // Half the peak (1e4 N) is reached at 0.01 m: E50 = 1e4 / 0.01 = 1e6.
+        assert!((m.stiffness_50.unwrap() - 1e6).abs() < 1e-6);
+    }
+
+    /// Before the peak is passed there is no residual capacity.
+    #[test]
+    fn rising_curve_has_no_residual() {
+        let m = CurveMetrics::from_curve(&[(0.01, 1.0), (0.02, 2.0)], 0.01);
+        assert_eq!(m.residual_load, None);
+        assert_eq!(m.peak_load, 2.0);
+    }
+}

@@ -12,6 +12,8 @@
 pub mod csv;
 /// ParaView `.pvd` collections: the time series of `.vtu` files.
 pub mod pvd;
+/// The run directory written as the run goes: curve, VTK series, summary.
+pub mod run_dir;
 /// VTK XML unstructured grids (`.vtu`): meshes, Gauss-point clouds, particle snapshots.
 pub mod vtk;
 

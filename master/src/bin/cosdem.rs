@@ -1,0 +1,184 @@
+//! `cosdem`: run a two-scale job file.
+//!
+//! ```text
+//! cosdem run JOB.toml [--workers LIST] [--out DIR] [--token-file FILE]
+//! ```
+//! With no workers given, the DEM assemblies are solved by in-process workers (no servers to
+//! start). The run directory is written as the run goes (see `cosdem_master::output::run_dir`).
+
+use anyhow::{Context, Result, bail};
+use clap::{Parser, Subcommand};
+use cosdem_master::job::{Job, MaterialSection};
+use cosdem_master::material::{ElasticCosserat, Material};
+use cosdem_master::output::run_dir::{RunSettings, RunWriter};
+use cosdem_master::solve::{SolutionView, Solver, StepObserver, StepReport};
+use indicatif::{ProgressBar, ProgressStyle};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+#[derive(Parser)]
+#[command(name = "cosdem", version, about = "Two-scale FEM x DEM for granular materials")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Run a job file.
+    Run(RunArgs),
+}
+
+#[derive(clap::Args)]
+struct RunArgs {
+    /// The job file (TOML).
+    job: PathBuf,
+    /// Remote workers: `host:port,host:port` or `dns:NAME:PORT`; default: in-process.
+    #[arg(long, value_delimiter = ',')]
+    workers: Vec<String>,
+    /// Run directory (default: the job's `[output] dir`, else `runs/<job stem>`).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// File holding the shared token for remote workers (else env COSDEM_TOKEN).
+    #[arg(long)]
+    token_file: Option<PathBuf>,
+    /// No progress bar (logs only).
+    #[arg(long)]
+    quiet: bool,
+}
+
+/// Forwards every step to the run writer and moves the progress bar.
+struct Progress<'a> {
+    writer: &'a mut RunWriter,
+    bar: ProgressBar,
+    started: Instant,
+}
+
+impl StepObserver for Progress<'_> {
+    fn on_step(&mut self, r: &StepReport, s: &SolutionView<'_>) -> cosdem_master::Result<()> {
+        self.writer.on_step(r, s)?;
+        let sum = self.writer.summary();
+        let secs = self.started.elapsed().as_secs_f64().max(1e-9);
+        let discs_per_s = sum.dem_steps as f64 / secs;
+        self.bar.set_position((r.load_factor * 1000.0).round() as u64);
+        self.bar.set_message(format!(
+            "step {} d={:.4e} m load={:.4e} N it={} DEM {:.2e} relax-steps/s",
+            r.step,
+            sum.displacement,
+            self.writer.curve().last().map_or(0.0, |p| p.1),
+            r.iterations,
+            discs_per_s
+        ));
+        tracing::info!(
+            step = r.step,
+            load_factor = r.load_factor,
+            displacement = sum.displacement,
+            iterations = r.iterations,
+            cuts = r.cuts,
+            "converged"
+        );
+        Ok(())
+    }
+}
+
+fn run_dir(args: &RunArgs, job: &Job) -> PathBuf {
+    if let Some(d) = &args.out {
+        return d.clone();
+    }
+    if let Some(d) = &job.output.dir {
+        return d.clone();
+    }
+    let stem = args.job.file_stem().map_or("run".into(), |s| s.to_string_lossy().into_owned());
+    Path::new("runs").join(stem)
+}
+
+fn init_logging(dir: &Path) -> Result<()> {
+    let file = std::fs::File::create(dir.join("cosdem.log"))
+        .with_context(|| format!("creating {}", dir.join("cosdem.log").display()))?;
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "info".into()),
+        )
+        .with_writer(std::sync::Mutex::new(file))
+        .with_ansi(false)
+        .init();
+    Ok(())
+}
+
+fn material(job: &Job, _args: &RunArgs) -> Result<(Box<dyn Material>, usize)> {
+    match &job.material {
+        MaterialSection::Elastic { shear_modulus, poisson, cosserat_modulus, length } => {
+            let g = *shear_modulus;
+            let m = ElasticCosserat::new(
+                g,
+                *poisson,
+                cosserat_modulus.unwrap_or(0.5 * g),
+                length.unwrap_or(0.01),
+            );
+            Ok((Box::new(m), 0))
+        }
+        MaterialSection::Dem { .. } => {
+            bail!("material kind \"dem\" needs the worker pool, which this build does not have")
+        }
+    }
+}
+
+fn run(args: RunArgs) -> Result<()> {
+    let job = Job::load(&args.job)?;
+    let dir = run_dir(&args, &job);
+    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    init_logging(&dir)?;
+    let internal_length = match &job.material {
+        MaterialSection::Elastic { length, .. } => length.unwrap_or(0.01),
+        MaterialSection::Dem { .. } => 0.01,
+    };
+    let settings = RunSettings {
+        title: job.title.clone(),
+        shortening: job.shortening(),
+        load_set: job.loading.load_set.clone(),
+        vtk_every: job.output.vtk_every,
+        internal_length,
+        linear_range: 0.01,
+    };
+    let mut writer = RunWriter::create(&dir, settings)?;
+    let (mut material, workers) = material(&job, &args)?;
+    writer.set_workers(workers);
+    let mut solver = Solver::new(job.model()?, job.solver_settings()?)?;
+    let bar = if args.quiet { ProgressBar::hidden() } else { ProgressBar::new(1000) };
+    bar.set_style(
+        ProgressStyle::with_template("[{elapsed_precise}] {bar:30} {percent:>3}% ETA {eta} {msg}")
+            .expect("static template"),
+    );
+    let span = tracing::info_span!("run", job = %args.job.display());
+    let _enter = span.enter();
+    let outcome = {
+        let mut progress =
+            Progress { writer: &mut writer, bar: bar.clone(), started: Instant::now() };
+        solver.run(material.as_mut(), &mut progress)
+    };
+    bar.finish_and_clear();
+    writer.finish(outcome.as_ref().map(|_| ()).map_err(|e| e.to_string()))?;
+    let s = writer.summary();
+    let m = &s.metrics;
+    println!(
+        "{} steps, d = {:.4e} m, F_u = {:.4e} N at {:.4e} m, F_res = {}, E = {}, E50 = {}, {:.1} s -> {}",
+        s.steps,
+        s.displacement,
+        m.peak_load,
+        m.peak_displacement,
+        m.residual_load.map_or("-".into(), |v| format!("{v:.4e} N")),
+        m.stiffness.map_or("-".into(), |v| format!("{v:.4e} N/m")),
+        m.stiffness_50.map_or("-".into(), |v| format!("{v:.4e} N/m")),
+        s.wall_seconds,
+        dir.display()
+    );
+    outcome.with_context(|| format!("run stopped; finished steps are in {}", dir.display()))?;
+    Ok(())
+}
+
+fn main() -> Result<()> {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Run(args) => run(args),
+    }
+}

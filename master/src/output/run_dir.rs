@@ -1,0 +1,243 @@
+//! The run directory, written as the run goes: a run killed halfway leaves every finished step
+//! readable.
+//!
+//! ```text
+//! RUN/curve.csv        one row per converged step (full-precision numbers)
+//! RUN/fields.pvd       ParaView collection of RUN/vtk/mesh_NNNNN.vtu (u, w per node)
+//! RUN/gauss.pvd        ParaView collection of RUN/vtk/gauss_NNNNN.vtu (stress, strain, q)
+//! RUN/summary.json     metrics so far (F_u, F_res, E, E50), DEM totals, status, wall time
+//! ```
+//! Everything but `summary.json`'s timing and worker fields is a deterministic function of the
+//! job, so two runs can be compared byte for byte.
+
+use super::csv::CsvWriter;
+use super::pvd::PvdWriter;
+use super::vtk::{gauss_point_piece, nodal_piece, write_vtu};
+use super::{OutputError, Result, write_atomic};
+use crate::post::CurveMetrics;
+use crate::solve::{SolutionView, StepObserver, StepReport};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Columns of `curve.csv`.
+pub const CURVE_COLUMNS: [&str; 8] = [
+    "step",
+    "load_factor",
+    "displacement",
+    "load",
+    "iterations",
+    "cuts",
+    "dem_steps",
+    "unconverged_points",
+];
+
+/// What the run writer needs to know about the job.
+#[derive(Clone, Debug)]
+pub struct RunSettings {
+    /// Free text for the summary.
+    pub title: String,
+    /// Displacement at load factor 1 (the curve's abscissa is `load_factor * shortening`).
+    pub shortening: f64,
+    /// Node set whose reaction is the load (compression positive: `-R_y`).
+    pub load_set: String,
+    /// Write VTK every this many steps (0: never).
+    pub vtk_every: usize,
+    /// Internal length for the equivalent strain (m).
+    pub internal_length: f64,
+    /// Upper end of the linear range for the stiffness E (m).
+    pub linear_range: f64,
+}
+
+/// The summary, rewritten atomically after every step.
+#[derive(Clone, Debug, Serialize)]
+pub struct Summary {
+    /// The job's title.
+    pub title: String,
+    /// `running`, `finished` or `failed: <reason>`.
+    pub status: String,
+    /// Converged steps so far.
+    pub steps: u64,
+    /// Displacement reached (m).
+    pub displacement: f64,
+    /// F_u, F_res, E, E50 of the curve so far.
+    pub metrics: CurveMetrics,
+    /// DEM steps summed over every Gauss point and converged step (0 for analytical materials).
+    pub dem_steps: u64,
+    /// Gauss-point relaxations that hit their step cap in converged steps.
+    pub capped_relaxations: u64,
+    /// Step cuts taken.
+    pub cuts: u64,
+    /// Wall time so far (s); not deterministic.
+    pub wall_seconds: f64,
+    /// Workers used (set by the caller).
+    pub workers: usize,
+}
+
+/// Writes the run directory; a [`StepObserver`].
+pub struct RunWriter {
+    dir: PathBuf,
+    settings: RunSettings,
+    csv: CsvWriter,
+    fields: Option<PvdWriter>,
+    gauss: Option<PvdWriter>,
+    curve: Vec<(f64, f64)>,
+    summary: Summary,
+    started: Instant,
+}
+
+impl RunWriter {
+    /// Creates the run directory (and `vtk/` in it) and the empty curve.
+    pub fn create(dir: &Path, settings: RunSettings) -> Result<Self> {
+        let mk = |p: &Path| {
+            std::fs::create_dir_all(p).map_err(|source| OutputError::Io {
+                path: p.to_path_buf(),
+                action: "create directory",
+                source,
+            })
+        };
+        mk(dir)?;
+        let (fields, gauss) = if settings.vtk_every > 0 {
+            mk(&dir.join("vtk"))?;
+            (
+                Some(PvdWriter::create(&dir.join("fields.pvd"))?),
+                Some(PvdWriter::create(&dir.join("gauss.pvd"))?),
+            )
+        } else {
+            (None, None)
+        };
+        let csv = CsvWriter::create(&dir.join("curve.csv"), &CURVE_COLUMNS)?;
+        let summary = Summary {
+            title: settings.title.clone(),
+            status: "running".into(),
+            steps: 0,
+            displacement: 0.0,
+            metrics: CurveMetrics::default(),
+            dem_steps: 0,
+            capped_relaxations: 0,
+            cuts: 0,
+            wall_seconds: 0.0,
+            workers: 0,
+        };
+        let mut w = Self {
+            dir: dir.to_path_buf(),
+            settings,
+            csv,
+            fields,
+            gauss,
+            curve: Vec::new(),
+            summary,
+            started: Instant::now(),
+        };
+        w.write_summary()?;
+        Ok(w)
+    }
+
+    /// The run directory.
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    /// The curve so far: `(displacement, load)` per converged step.
+    pub fn curve(&self) -> &[(f64, f64)] {
+        &self.curve
+    }
+
+    /// The summary so far.
+    pub fn summary(&self) -> &Summary {
+        &self.summary
+    }
+
+    /// Records the number of workers in the summary.
+    pub fn set_workers(&mut self, n: usize) {
+        self.summary.workers = n;
+    }
+
+    /// Marks the run finished (or failed, with the reason) and writes the summary.
+    pub fn finish(&mut self, outcome: std::result::Result<(), String>) -> Result<()> {
+        self.summary.status = match outcome {
+            Ok(()) => "finished".into(),
+            Err(why) => format!("failed: {why}"),
+        };
+        self.write_summary()
+    }
+
+    fn write_summary(&mut self) -> Result<()> {
+        self.summary.wall_seconds = self.started.elapsed().as_secs_f64();
+        let path = self.dir.join("summary.json");
+        let mut text = serde_json::to_string_pretty(&self.summary)
+            .map_err(|e| OutputError::InvalidData { path: path.clone(), message: e.to_string() })?;
+        text.push('\n');
+        write_atomic(&path, text.as_bytes())
+    }
+
+    fn write_vtk(&mut self, step: u64, view: &SolutionView<'_>) -> Result<()> {
+        let time = self.summary.displacement;
+        let mesh = view.mesh;
+        let npe = mesh.kind.nodes();
+        let elements: Vec<Vec<usize>> = mesh.connectivity.chunks(npe).map(|c| c.to_vec()).collect();
+        let dofs: Vec<[f64; 3]> = view
+            .displacements()
+            .iter()
+            .zip(view.rotations())
+            .map(|(u, w)| [u[0], u[1], w])
+            .collect();
+        let path = self.dir.join(format!("vtk/mesh_{step:05}.vtu"));
+        let mut piece = nodal_piece(&path, &mesh.nodes, &elements, &dofs)?;
+        piece.time = Some(time);
+        write_vtu(&path, &piece)?;
+        if let Some(pvd) = &mut self.fields {
+            pvd.add(time, &path)?;
+        }
+        let gp = view.gauss_points;
+        let positions: Vec<[f64; 2]> = gp.iter().map(|g| g.position).collect();
+        let strain: Vec<[f64; 6]> = gp.iter().map(|g| g.strain).collect();
+        let stress: Vec<[f64; 6]> = gp.iter().map(|g| g.stress).collect();
+        let mut piece =
+            gauss_point_piece(&positions, &strain, &stress, self.settings.internal_length);
+        piece.time = Some(time);
+        let path = self.dir.join(format!("vtk/gauss_{step:05}.vtu"));
+        write_vtu(&path, &piece)?;
+        if let Some(pvd) = &mut self.gauss {
+            pvd.add(time, &path)?;
+        }
+        Ok(())
+    }
+}
+
+impl StepObserver for RunWriter {
+    fn on_step(&mut self, report: &StepReport, view: &SolutionView<'_>) -> crate::Result<()> {
+        let displacement = report.load_factor * self.settings.shortening;
+        let load = -report.reactions.get(&self.settings.load_set).map_or(0.0, |r| r[1]);
+        let dem_steps: u64 = view.gauss_points.iter().map(|g| g.diagnostics.steps).sum();
+        let capped = view
+            .gauss_points
+            .iter()
+            .filter(|g| g.diagnostics.steps > 0 && !g.diagnostics.converged);
+        let capped = capped.count() as u64;
+        self.curve.push((displacement, load));
+        self.summary.steps = report.step;
+        self.summary.displacement = displacement;
+        self.summary.dem_steps += dem_steps;
+        self.summary.capped_relaxations += capped;
+        self.summary.cuts += u64::from(report.cuts);
+        self.summary.metrics = CurveMetrics::from_curve(&self.curve, self.settings.linear_range);
+        let row = [
+            report.step as f64,
+            report.load_factor,
+            displacement,
+            load,
+            f64::from(report.iterations),
+            f64::from(report.cuts),
+            dem_steps as f64,
+            capped as f64,
+        ];
+        let io = |e: OutputError| crate::Error::Observer(e.to_string());
+        self.csv.write_row(&row).map_err(io)?;
+        let every = self.settings.vtk_every;
+        if every > 0 && report.step % every as u64 == 0 {
+            self.write_vtk(report.step, view).map_err(io)?;
+        }
+        self.write_summary().map_err(io)
+    }
+}
