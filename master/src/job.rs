@@ -339,7 +339,7 @@ impl Default for OutputSection {
 }
 
 /// `[workers]`.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct WorkersSection {
     /// Remote workers `host:port` or `dns:NAME:PORT`; empty: in-process workers.
@@ -348,11 +348,6 @@ pub struct WorkersSection {
     pub in_process: usize,
 }
 
-impl Default for WorkersSection {
-    fn default() -> Self {
-        Self { addresses: Vec::new(), in_process: 0 }
-    }
-}
 
 fn bad(field: &'static str, value: impl ToString, reason: &str) -> Error {
     Error::InvalidSetting { field, value: value.to_string(), reason: reason.into() }

@@ -235,7 +235,7 @@ impl StepObserver for RunWriter {
         let io = |e: OutputError| crate::Error::Observer(e.to_string());
         self.csv.write_row(&row).map_err(io)?;
         let every = self.settings.vtk_every;
-        if every > 0 && report.step % every as u64 == 0 {
+        if every > 0 && report.step.is_multiple_of(every as u64) {
             self.write_vtk(report.step, view).map_err(io)?;
         }
         self.write_summary().map_err(io)
