@@ -39,7 +39,8 @@ pub enum MaterialError {
 }
 
 fn describe(points: &[(GaussPointId, String)]) -> String {
-    let mut s: Vec<String> = points.iter().take(8).map(|(id, why)| format!("{id}: {why}")).collect();
+    let mut s: Vec<String> =
+        points.iter().take(8).map(|(id, why)| format!("{id}: {why}")).collect();
     if points.len() > 8 {
         s.push(format!("and {} more", points.len() - 8));
     }
