@@ -147,6 +147,11 @@ pub struct Pool {
 
 impl Drop for Pool {
     fn drop(&mut self) {
+        // Free the assemblies on remote workers (best effort, bounded), unless dropped
+        // inside an async context where blocking is not allowed.
+        if tokio::runtime::Handle::try_current().is_err() && !self.sources.is_empty() {
+            self.release();
+        }
         // Do not wait for relaxations still running in in-process workers.
         if let Some(rt) = self.rt.take() {
             rt.shutdown_background();
@@ -239,7 +244,12 @@ impl Pool {
                 )
                 .await
                 {
-                    Ok(link) => pool.workers.push(Worker { link, addr: Some(addr), alive: true }),
+                    Ok(link) => {
+                        // One master per worker: whatever a previous master left is stale.
+                        let t = c.call_timeout;
+                        link.drop_assemblies(&[], t).await.map_err(|s| refused(&link.name, &s))?;
+                        pool.workers.push(Worker { link, addr: Some(addr), alive: true });
+                    }
                     Err(s) if matches!(s.code(), Code::Unavailable | Code::DeadlineExceeded) => {
                         tracing::warn!(%addr, error = %s.message(), "worker unreachable, skipped");
                     }
@@ -374,6 +384,23 @@ impl Pool {
     ) -> Result<(), PoolError> {
         let h = self.handle.clone();
         h.block_on(self.create_async(ids, spec))
+    }
+
+    /// Frees every assembly on the live workers (best effort, one call timeout at most).
+    /// Called when the pool is dropped; the pool holds no assemblies afterwards.
+    pub fn release(&mut self) {
+        let t = self.config.connect_timeout;
+        let links: Vec<_> =
+            self.workers.iter().filter(|w| w.alive).map(|w| w.link.clone()).collect();
+        self.handle.block_on(async move {
+            for l in links {
+                let _ = l.drop_assemblies(&[], t).await;
+            }
+        });
+        self.owner.clear();
+        self.committed.clear();
+        self.costs.clear();
+        self.last = None;
     }
 
     /// Particle-level snapshot of one assembly (committed state).
