@@ -62,3 +62,10 @@ fn public_address_without_token_is_refused() {
     assert!(err.contains("without a token"), "{err}");
     assert!(format!("{:?}", Token::new("hidden").unwrap()).contains("redacted"));
 }
+
+#[test]
+fn pool_without_token_refuses_public_workers() {
+    let err = Pool::connect(&["10.255.255.1:50051".to_string()], test_config()).err().unwrap();
+    assert!(matches!(err, PoolError::Config(_)), "{err}");
+    assert!(err.to_string().contains("token is required"), "{err}");
+}

@@ -221,6 +221,7 @@ impl Pool {
         let handle = rt.handle().clone();
         let mut pool = Pool::empty(rt, handle, config);
         pool.sources = addresses.to_vec();
+        let public = |a: &SocketAddr| !a.ip().is_loopback();
         let h = pool.handle.clone();
         h.block_on(async {
             let mut addrs = Vec::new();
@@ -230,6 +231,13 @@ impl Pool {
                     tracing::warn!(source = %s, "no address for worker");
                 }
                 addrs.extend(found);
+            }
+            if pool.config.token.is_none()
+                && let Some(a) = addrs.iter().find(|a| public(a))
+            {
+                return Err(PoolError::Config(format!(
+                    "worker {a} is not on loopback: a token is required (COSDEM_TOKEN or --token-file)"
+                )));
             }
             for addr in addrs {
                 if pool.workers.iter().any(|w| w.addr == Some(addr)) {

@@ -177,6 +177,16 @@ impl<M: MicroModel> Registry<M> {
             .collect()
     }
 
+    /// A relaxation is queued: counted in flight until [`Registry::end`].
+    pub fn begin(&self) {
+        self.in_flight.fetch_add(1, Ordering::SeqCst);
+    }
+
+    /// A queued relaxation has finished.
+    pub fn end(&self) {
+        self.in_flight.fetch_sub(1, Ordering::SeqCst);
+    }
+
     /// Solves one assembly for trial (step, iteration); a repeat of the last trial returns
     /// its cached outcome.
     pub fn solve(
@@ -199,10 +209,8 @@ impl<M: MicroModel> Registry<M> {
                 h.0, slot.committed_step
             ));
         }
-        self.in_flight.fetch_add(1, Ordering::SeqCst);
         let slot = &mut *slot;
         let outcome = self.model.solve(&mut slot.assembly, &target).map_err(|e| e.to_string());
-        self.in_flight.fetch_sub(1, Ordering::SeqCst);
         slot.trial = Some(Trial { step, iteration, target, outcome: outcome.clone() });
         outcome
     }

@@ -152,8 +152,10 @@ impl<M: MicroModel> MicroSolver for WorkerService<M> {
         for (h, (_, target)) in handles.into_iter().zip(items) {
             let registry = self.registry.clone();
             let tx = tx.clone();
+            registry.begin();
             self.relax.spawn(move || {
                 let outcome = registry.solve(&h, step, iteration, target);
+                registry.end();
                 // The caller may have gone (deadline); the cached trial still serves a retry.
                 let _ = tx.send(Ok(to_proto::solve_result(h.id(), &outcome)));
             });
