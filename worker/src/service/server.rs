@@ -40,15 +40,14 @@ impl<M: MicroModel> WorkerService<M> {
     }
 }
 
-/// Runs blocking work off the async runtime, inside the relaxation pool (so nested rayon
-/// parallelism uses it too).
+/// Runs blocking work off the async runtime. Not on the relaxation pool: commit, export and
+/// rollback must not queue behind long relaxations (a deadline would declare us dead).
 async fn blocking<M: MicroModel, T: Send + 'static>(
     s: &WorkerService<M>,
     f: impl FnOnce(&Registry<M>) -> Result<T, ServiceError> + Send + 'static,
 ) -> Result<T, Status> {
     let registry = s.registry.clone();
-    let pool = s.relax.clone();
-    tokio::task::spawn_blocking(move || pool.install(|| f(&registry)))
+    tokio::task::spawn_blocking(move || f(&registry))
         .await
         .map_err(|e| Status::from(ServiceError::Internal(format!("task lost: {e}"))))?
         .map_err(Status::from)
@@ -114,6 +113,7 @@ impl<M: MicroModel> MicroSolver for WorkerService<M> {
             .try_into()
             .map_err(|e| invalid("spec", e))?;
         let ids = ids(req.ids);
+        let relax = self.relax.clone();
         let infos = blocking(self, move |r| {
             let mut seen = std::collections::HashSet::new();
             if let Some(id) = ids.iter().find(|id| !seen.insert(**id)) {
@@ -121,7 +121,8 @@ impl<M: MicroModel> MicroSolver for WorkerService<M> {
                     "{id} appears twice in one request"
                 )));
             }
-            r.create(&ids, &spec)
+            // Building packings is heavy: use the relaxation threads.
+            relax.install(|| r.create(&ids, &spec))
         })
         .await?;
         Ok(Response::new(pb::CreateAssembliesReply {
