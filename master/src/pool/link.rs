@@ -69,18 +69,34 @@ pub fn endpoint(uri: String, connect_timeout: Duration) -> Result<Endpoint, Stat
         .keep_alive_while_idle(true))
 }
 
-/// Connects over TCP and shakes hands.
+/// Connects over TCP (TLS if configured) and shakes hands.
 pub async fn connect_tcp(
     addr: std::net::SocketAddr,
-    token: Option<Token>,
-    connect_timeout: Duration,
-    max_message: usize,
+    c: &super::PoolConfig,
 ) -> Result<Link, Status> {
-    let channel = endpoint(format!("http://{addr}"), connect_timeout)?
-        .connect()
-        .await
-        .map_err(|e| Status::unavailable(format!("connect {addr}: {e}")))?;
-    handshake(addr.to_string(), client(channel, token, max_message), connect_timeout).await
+    let scheme = if c.tls.is_some() { "https" } else { "http" };
+    #[allow(unused_mut)]
+    let mut ep = endpoint(format!("{scheme}://{addr}"), c.connect_timeout)?;
+    if let Some(_tls) = &c.tls {
+        #[cfg(feature = "tls")]
+        {
+            use tonic::transport::{Certificate, ClientTlsConfig};
+            let tls = ClientTlsConfig::new()
+                .ca_certificate(Certificate::from_pem(&_tls.ca_pem))
+                .domain_name(_tls.domain.clone());
+            ep = ep.tls_config(tls).map_err(|e| Status::invalid_argument(format!("TLS: {e}")))?;
+        }
+        #[cfg(not(feature = "tls"))]
+        return Err(Status::invalid_argument("TLS asked for, but built without the `tls` feature"));
+    }
+    let channel =
+        ep.connect().await.map_err(|e| Status::unavailable(format!("connect {addr}: {e}")))?;
+    handshake(
+        addr.to_string(),
+        client(channel, c.token.clone(), c.max_message_bytes),
+        c.connect_timeout,
+    )
+    .await
 }
 
 /// A client over in-memory duplex pipes: each (re)connection sends the server half of a new

@@ -70,6 +70,15 @@ pub enum PoolError {
     Unavailable(String),
 }
 
+/// TLS towards remote workers (needs the `tls` feature).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ClientTls {
+    /// CA certificate(s) that sign the workers' certificates (PEM).
+    pub ca_pem: Vec<u8>,
+    /// Name the workers' certificates are issued for (checked against them).
+    pub domain: String,
+}
+
 /// How the pool talks to its workers.
 #[derive(Clone, Debug)]
 pub struct PoolConfig {
@@ -90,6 +99,8 @@ pub struct PoolConfig {
     pub runtime_threads: usize,
     /// Relaxation threads of each in-process worker (0 = cores / workers, at least 1).
     pub in_process_threads: usize,
+    /// TLS to remote workers (needs the `tls` feature; in-process workers never use it).
+    pub tls: Option<ClientTls>,
 }
 
 impl Default for PoolConfig {
@@ -103,6 +114,7 @@ impl Default for PoolConfig {
             rebalance_threshold: 1.25,
             runtime_threads: 2,
             in_process_threads: 0,
+            tls: None,
         }
     }
 }
@@ -244,13 +256,7 @@ impl Pool {
                     continue;
                 }
                 let c = &pool.config;
-                match link::connect_tcp(
-                    addr,
-                    c.token.clone(),
-                    c.connect_timeout,
-                    c.max_message_bytes,
-                )
-                .await
+                match link::connect_tcp(addr, c).await
                 {
                     Ok(link) => {
                         // One master per worker: whatever a previous master left is stale.
@@ -849,10 +855,7 @@ impl Pool {
                 continue;
             }
             let c = &self.config;
-            let Ok(link) =
-                link::connect_tcp(addr, c.token.clone(), c.connect_timeout, c.max_message_bytes)
-                    .await
-            else {
+            let Ok(link) = link::connect_tcp(addr, c).await else {
                 continue;
             };
             match link.health(c.connect_timeout).await {

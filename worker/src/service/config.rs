@@ -27,6 +27,32 @@ impl Default for Limits {
     }
 }
 
+/// A TLS identity for the listener: certificate chain and private key, PEM. Only used when
+/// the crate is built with the `tls` feature; `Debug` never shows the key.
+#[derive(Clone, PartialEq, Eq)]
+pub struct TlsIdentity {
+    /// Certificate chain (PEM).
+    pub cert_pem: Vec<u8>,
+    /// Private key (PEM).
+    pub key_pem: Vec<u8>,
+}
+
+impl std::fmt::Debug for TlsIdentity {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("TlsIdentity(<redacted>)")
+    }
+}
+
+impl TlsIdentity {
+    /// Reads the certificate and key files.
+    pub fn load(cert: &std::path::Path, key: &std::path::Path) -> Result<Self> {
+        let read = |p: &std::path::Path| {
+            std::fs::read(p).map_err(|e| ServiceError::Config(format!("{}: {e}", p.display())))
+        };
+        Ok(TlsIdentity { cert_pem: read(cert)?, key_pem: read(key)? })
+    }
+}
+
 /// Everything [`super::serve`] needs.
 #[derive(Clone, Debug)]
 pub struct WorkerConfig {
@@ -38,6 +64,8 @@ pub struct WorkerConfig {
     pub threads: usize,
     /// Limits.
     pub limits: Limits,
+    /// Serve TLS with this identity (needs the `tls` feature); the token is still checked.
+    pub tls: Option<TlsIdentity>,
 }
 
 impl Default for WorkerConfig {
@@ -47,6 +75,7 @@ impl Default for WorkerConfig {
             token: None,
             threads: 0,
             limits: Limits::default(),
+            tls: None,
         }
     }
 }
@@ -60,6 +89,11 @@ impl WorkerConfig {
                  (set COSDEM_TOKEN or --token-file)",
                 self.listen
             )));
+        }
+        if self.tls.is_some() && !cfg!(feature = "tls") {
+            return Err(ServiceError::Config(
+                "TLS asked for, but built without the `tls` feature".into(),
+            ));
         }
         if self.limits.max_message_bytes == 0 {
             return Err(ServiceError::Config("max message size must be > 0".into()));
@@ -95,6 +129,12 @@ pub struct ListenArgs {
     /// Most discs held at once, over all assemblies (0 = unlimited).
     #[arg(long, default_value_t = 0)]
     pub max_discs: u64,
+    /// TLS certificate chain (PEM); with `--tls-key`, serves TLS (needs the `tls` feature).
+    #[arg(long, requires = "tls_key")]
+    pub tls_cert: Option<PathBuf>,
+    /// TLS private key (PEM).
+    #[arg(long, requires = "tls_cert")]
+    pub tls_key: Option<PathBuf>,
     /// Largest gRPC message, in MiB.
     #[arg(long, default_value_t = 256)]
     pub max_message_mib: usize,
@@ -111,6 +151,10 @@ impl TryFrom<ListenArgs> for WorkerConfig {
                 max_assemblies: a.max_assemblies,
                 max_discs: a.max_discs,
                 max_message_bytes: a.max_message_mib.saturating_mul(1024 * 1024),
+            },
+            tls: match (&a.tls_cert, &a.tls_key) {
+                (Some(c), Some(k)) => Some(TlsIdentity::load(c, k)?),
+                _ => None,
             },
         };
         config.validate()?;

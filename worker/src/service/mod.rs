@@ -11,6 +11,7 @@
 //!   an oversized message OUT_OF_RANGE (tonic's code, raised before the service runs),
 //!   missing or wrong token UNAUTHENTICATED. A failed relaxation is not a status: it comes
 //!   back in-band in its `SolveResult`.
+//! - TLS (feature `tls`, rustls with ring): [`WorkerConfig::tls`] / `--tls-cert --tls-key`.
 
 mod auth;
 mod config;
@@ -21,7 +22,7 @@ mod server;
 mod standin;
 
 pub use auth::{AttachToken, CheckToken, TOKEN_ENV, Token};
-pub use config::{Limits, ListenArgs, WorkerConfig};
+pub use config::{Limits, ListenArgs, TlsIdentity, WorkerConfig};
 pub use error::{Result, ServiceError};
 pub use model::{MicroModel, ModelError};
 pub use server::WorkerService;
@@ -48,7 +49,17 @@ async fn router<M: MicroModel>(model: M, config: &WorkerConfig) -> Result<Router
         .max_decoding_message_size(max)
         .max_encoding_message_size(max);
     reporter.set_serving::<MicroSolverServer<WorkerService<M>>>().await;
-    Ok(Server::builder()
+    #[allow(unused_mut)]
+    let mut builder = Server::builder();
+    #[cfg(feature = "tls")]
+    if let Some(tls) = &config.tls {
+        use tonic::transport::{Identity, ServerTlsConfig};
+        let identity = Identity::from_pem(&tls.cert_pem, &tls.key_pem);
+        builder = builder
+            .tls_config(ServerTlsConfig::new().identity(identity))
+            .map_err(|e| ServiceError::Config(format!("TLS: {e}")))?;
+    }
+    Ok(builder
         .http2_keepalive_interval(Some(KEEPALIVE))
         .add_service(health)
         .add_service(InterceptedService::new(service, CheckToken(config.token.clone()))))
@@ -99,6 +110,8 @@ pub async fn serve_duplex<M: MicroModel>(
     shutdown: impl Future<Output = ()>,
 ) -> Result<()> {
     use tokio_stream::StreamExt;
+    // In memory, in one process: no TLS.
+    let config = WorkerConfig { tls: None, ..config };
     let incoming = tokio_stream::wrappers::UnboundedReceiverStream::new(connections)
         .map(Ok::<_, std::io::Error>);
     router(model, &config)
