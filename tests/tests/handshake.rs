@@ -89,7 +89,7 @@ async fn handshake_and_health_answer_while_relaxations_run() {
         .unwrap()
         .into_inner();
     assert_eq!(s.status(), tonic_health::pb::health_check_response::ServingStatus::Serving);
-    assert!(t.elapsed() < Duration::from_secs(1), "answered in {:?}", t.elapsed());
+    assert!(t.elapsed() < Duration::from_secs(2), "answered in {:?}", t.elapsed());
     assert!(!solving.is_finished());
     solving.abort();
 }

@@ -1,7 +1,8 @@
 //! Where each Gauss point's assembly lives: pure functions on costs and capacities.
 //!
-//! Cost of an assembly: its measured solve time when every assembly has one, else its disc
-//! count scaled by the measured seconds per disc (or the disc count alone before any solve).
+//! Cost of an assembly: its measured solve time (smoothed over iterations) when it has one,
+//! else its disc count scaled by the measured seconds per disc (or the disc count alone
+//! before any solve).
 //! Load of a worker: the sum of its assemblies' costs divided by its cores.
 
 use cosdem_common::GaussPointId;

@@ -665,7 +665,9 @@ impl Pool {
             match out.remove(&input.gauss_point) {
                 Some(Ok(r)) => {
                     if let Some(c) = self.costs.get_mut(&input.gauss_point) {
-                        c.seconds = Some(r.diagnostics.wall_seconds);
+                        // Smoothed, so that timing noise does not shuffle assemblies.
+                        let t = r.diagnostics.wall_seconds;
+                        c.seconds = Some(c.seconds.map_or(t, |old| 0.5 * (old + t)));
                     }
                     responses.push(r);
                 }
