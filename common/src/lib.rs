@@ -8,6 +8,8 @@
 pub mod gauss;
 /// The macro deformation sent to a Gauss point and the strain vector derived from it.
 pub mod kinematics;
+/// Assembly specs, committed states and snapshots exchanged between master and workers.
+pub mod micro;
 /// The homogenized answer of a micro solve: stress, tangent and diagnostics.
 pub mod response;
 /// Voigt index order shared by every crate.

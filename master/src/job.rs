@@ -348,7 +348,6 @@ pub struct WorkersSection {
     pub in_process: usize,
 }
 
-
 fn bad(field: &'static str, value: impl ToString, reason: &str) -> Error {
     Error::InvalidSetting { field, value: value.to_string(), reason: reason.into() }
 }

@@ -49,6 +49,8 @@ pub mod material;
 pub mod mesh;
 /// Writing results: VTK unstructured grids, ParaView collections, CSV curves.
 pub mod output;
+/// The DEM-backed material: a pool of workers (remote or in-process), with failover and balancing.
+pub mod pool;
 /// Derived quantities for plots (equivalent strain, Eq. 34).
 pub mod post;
 /// Loading, linear solves, Newton-Raphson with step cutting, step observers.

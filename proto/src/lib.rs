@@ -1,7 +1,8 @@
 //! The gRPC contract between master and workers, generated from `proto/cosdem.proto`.
 //!
 //! Nothing outside the RPC layers (the worker's service and the master's pool) should pass
-//! these prost types around: they convert to the domain types of `cosdem-common` at the edge.
+//! these prost types around: they convert to the domain types of `cosdem-common` at the edge,
+//! with the conversions of this crate, shared by both sides.
 
 /// Generated messages, client and server of package `cosdem.v1`.
 #[allow(missing_docs, clippy::all)]
@@ -9,5 +10,19 @@ pub mod v1 {
     tonic::include_proto!("cosdem.v1");
 }
 
+/// Wire -> domain conversions, validating as they go.
+pub mod from_proto;
+/// Domain -> wire conversions.
+pub mod to_proto;
+
+pub use from_proto::ConvertError;
+
 /// The protocol version a master and a worker must agree on at handshake.
 pub const PROTOCOL_VERSION: u32 = 1;
+
+/// Default limit on one gRPC message, both directions (256 MiB): large assemblies'
+/// exported states and snapshots must pass.
+pub const DEFAULT_MAX_MESSAGE_BYTES: usize = 256 * 1024 * 1024;
+
+/// Metadata key carrying the shared secret (`Bearer <token>`).
+pub const AUTHORIZATION: &str = "authorization";

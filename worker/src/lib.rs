@@ -36,6 +36,8 @@ pub mod homogenize;
 pub mod integrate;
 /// Reference packings (hexagonal, random).
 pub mod packing;
+/// The gRPC service (`cosdem.v1.MicroSolver`) around a micro model: serve, limits, token.
+pub mod service;
 /// The serde specification of an assembly.
 pub mod spec;
 

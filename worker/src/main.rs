@@ -1,5 +1,10 @@
-//! `cosdem-worker`: the DEM worker binary (benchmarks now; the gRPC `listen` mode is added by
-//! the service).
+//! `cosdem-worker`: the DEM worker binary.
+//!
+//! ```text
+//! cosdem-worker listen --listen 0.0.0.0:7700 [--token-file FILE] [--threads N]
+//! cosdem-worker health --addr HOST:PORT
+//! cosdem-worker bench dem [--quick]
+//! ```
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
@@ -15,6 +20,17 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
+    /// Serve DEM assemblies over gRPC until SIGTERM / Ctrl-C.
+    Listen(cosdem_worker::service::ListenArgs),
+    /// Exit 0 iff the worker at `--addr` reports SERVING (for container health checks).
+    Health {
+        /// `host:port` of the worker.
+        #[arg(long, default_value = "127.0.0.1:7700")]
+        addr: String,
+        /// Seconds to wait for the answer.
+        #[arg(long, default_value_t = 5)]
+        timeout: u64,
+    },
     /// Benchmarks.
     Bench {
         #[command(subcommand)]
@@ -35,6 +51,8 @@ enum BenchWhat {
 fn main() -> Result<()> {
     let cli = Cli::parse();
     match cli.command {
+        Command::Listen(args) => listen(args),
+        Command::Health { addr, timeout } => health(&addr, timeout),
         Command::Bench { what: BenchWhat::Dem { quick } } => bench_dem(quick),
     }
 }
@@ -55,4 +73,42 @@ fn bench_dem(quick: bool) -> Result<()> {
         println!("random packing 0.0784 m^2 ({n} discs, {boundary:?}): built in {wall:.3} s");
     }
     Ok(())
+}
+
+fn listen(args: cosdem_worker::service::ListenArgs) -> Result<()> {
+    use cosdem_worker::service::{Dem, WorkerConfig, serve, shutdown_signal};
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "info".into()),
+        )
+        .with_writer(std::io::stderr)
+        .init();
+    let config: WorkerConfig = args.try_into()?;
+    let runtime = tokio::runtime::Builder::new_multi_thread().enable_all().build()?;
+    runtime.block_on(serve(config, Dem, shutdown_signal()))?;
+    Ok(())
+}
+
+fn health(addr: &str, timeout: u64) -> Result<()> {
+    use tonic_health::pb::health_check_response::ServingStatus;
+    use tonic_health::pb::{HealthCheckRequest, health_client::HealthClient};
+    let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build()?;
+    runtime.block_on(async {
+        let uri = format!("http://{addr}");
+        let channel = tonic::transport::Endpoint::from_shared(uri)?
+            .connect_timeout(std::time::Duration::from_secs(timeout))
+            .timeout(std::time::Duration::from_secs(timeout))
+            .connect()
+            .await?;
+        let reply = HealthClient::new(channel)
+            .check(HealthCheckRequest { service: String::new() })
+            .await?
+            .into_inner();
+        anyhow::ensure!(
+            reply.status == ServingStatus::Serving as i32,
+            "worker at {addr} is not serving (status {})",
+            reply.status
+        );
+        Ok(())
+    })
 }

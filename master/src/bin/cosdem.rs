@@ -6,12 +6,16 @@
 //! With no workers given, the DEM assemblies are solved by in-process workers (no servers to
 //! start). The run directory is written as the run goes (see `cosdem_master::output::run_dir`).
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
+use cosdem_common::GaussPointId;
+use cosdem_common::micro::{AssemblyRequest, BoundaryKind};
 use cosdem_master::job::{Job, MaterialSection};
 use cosdem_master::material::{ElasticCosserat, Material};
 use cosdem_master::output::run_dir::{RunSettings, RunWriter};
+use cosdem_master::pool::{Pool, PoolConfig};
 use cosdem_master::solve::{SolutionView, Solver, StepObserver, StepReport};
+use cosdem_worker::service::{Dem, Token};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -105,7 +109,38 @@ fn init_logging(dir: &Path) -> Result<()> {
     Ok(())
 }
 
-fn material(job: &Job, _args: &RunArgs) -> Result<(Box<dyn Material>, usize)> {
+/// The DEM pool: remote workers when addresses are given (CLI first, then the job), else
+/// in-process workers (no servers to start).
+fn dem_pool(
+    job: &Job,
+    args: &RunArgs,
+    spec: &cosdem_worker::AssemblySpec,
+    ids: &[GaussPointId],
+) -> Result<Pool> {
+    let token = Token::load(args.token_file.as_deref())?;
+    let config = PoolConfig { token, ..PoolConfig::default() };
+    let addresses: Vec<String> =
+        if args.workers.is_empty() { job.workers.addresses.clone() } else { args.workers.clone() };
+    // `dns:NAME:PORT` (a headless service) is the same as `NAME:PORT`: every address the name
+    // resolves to becomes a worker.
+    let addresses: Vec<String> =
+        addresses.iter().map(|a| a.strip_prefix("dns:").unwrap_or(a).to_string()).collect();
+    let mut pool = if addresses.is_empty() {
+        let n = job.workers.in_process.max(1);
+        Pool::in_process(n, config, |_| Dem)?
+    } else {
+        Pool::connect(&addresses, config)?
+    };
+    let request = AssemblyRequest {
+        spec_json: serde_json::to_vec(spec)?,
+        boundary: BoundaryKind::Unspecified,
+        disc_count_hint: 0,
+    };
+    pool.create_assemblies(ids, &request)?;
+    Ok(pool)
+}
+
+fn material(job: &Job, args: &RunArgs, ids: &[GaussPointId]) -> Result<(Box<dyn Material>, usize)> {
     match &job.material {
         MaterialSection::Elastic { shear_modulus, poisson, cosserat_modulus, length } => {
             let g = *shear_modulus;
@@ -117,8 +152,10 @@ fn material(job: &Job, _args: &RunArgs) -> Result<(Box<dyn Material>, usize)> {
             );
             Ok((Box::new(m), 0))
         }
-        MaterialSection::Dem { .. } => {
-            bail!("material kind \"dem\" needs the worker pool, which this build does not have")
+        MaterialSection::Dem { assembly } => {
+            let pool = dem_pool(job, args, assembly, ids)?;
+            let n = pool.live_workers();
+            Ok((Box::new(pool), n))
         }
     }
 }
@@ -141,9 +178,13 @@ fn run(args: RunArgs) -> Result<()> {
         linear_range: 0.01,
     };
     let mut writer = RunWriter::create(&dir, settings)?;
-    let (mut material, workers) = material(&job, &args)?;
-    writer.set_workers(workers);
     let mut solver = Solver::new(job.model()?, job.solver_settings()?)?;
+    let per_element = solver.gauss().per_element as u32;
+    let ids: Vec<GaussPointId> = (0..solver.model().mesh.n_elements() as u32)
+        .flat_map(|e| (0..per_element).map(move |p| GaussPointId::new(e, p)))
+        .collect();
+    let (mut material, workers) = material(&job, &args, &ids)?;
+    writer.set_workers(workers);
     let bar = if args.quiet { ProgressBar::hidden() } else { ProgressBar::new(1000) };
     bar.set_style(
         ProgressStyle::with_template("[{elapsed_precise}] {bar:30} {percent:>3}% ETA {eta} {msg}")

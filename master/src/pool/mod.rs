@@ -1,0 +1,902 @@
+//! The worker pool: the DEM-backed [`Material`], one assembly per Gauss point on a set of
+//! stateful workers (remote over gRPC, or in-process over in-memory pipes).
+//!
+//! # Life cycle
+//! [`Pool::connect`] (addresses `host:port`; a DNS name resolving to several addresses gives
+//! one worker per address) or [`Pool::in_process`], then [`Pool::create_assemblies`], then the
+//! FE solver drives it through [`Material`]: `evaluate` (one `SolveBatch` per worker per Newton
+//! iteration, all workers concurrently, each bounded by [`PoolConfig::solve_timeout`]),
+//! `commit`, `rollback`.
+//!
+//! # Runtime
+//! `Material` is synchronous; the pool owns a small multi-threaded tokio runtime and blocks
+//! on it. So its methods must not be called from inside an async context (call them from a
+//! plain thread, or from `tokio::task::spawn_blocking`).
+//!
+//! # Fault tolerance
+//! The master keeps every assembly's last committed state: `Commit` asks each worker to
+//! return the newly committed states in its reply (`export_state`), so each commit costs one
+//! copy of every assembly's state over the network and in master memory (for the DEM: about
+//! positions, rotations and contact history of every disc, tens of bytes per disc). When a
+//! worker fails (transport error, deadline, lost assemblies), it is marked dead, its
+//! assemblies are imported on the remaining workers from those states, and the Gauss points
+//! it owed are solved again there; a worker lost during `commit` has its points re-solved
+//! from the stored state at the last trial and committed on their new owner. Because a solve
+//! is deterministic given (committed state, target), the results are bit-identical to a run
+//! without failure (diagnostics' `wall_seconds` aside). A worker that comes back, or a new
+//! address behind a DNS name, is admitted at the next load step once idle.
+//!
+//! # Balance
+//! Assemblies are placed by expected cost (disc count, then measured solve time) per core;
+//! at each new load step, if the most loaded worker exceeds the mean by
+//! [`PoolConfig::rebalance_threshold`], assemblies migrate (import of the stored committed
+//! state on the new owner, drop on the old one).
+
+mod balance;
+mod link;
+
+pub use balance::Cost;
+pub use link::WorkerInfo;
+
+use crate::material::{Material, MaterialError, MaterialInput, TrialId};
+use balance::{effective_costs, place, rebalance};
+use cosdem_common::micro::{AssemblyRequest, AssemblyState, MicroSnapshot};
+use cosdem_common::{GaussPointId, MacroDeformation, MicroResponse};
+use cosdem_worker::service::{Limits, MicroModel, Token, WorkerConfig, serve_duplex};
+use link::{Link, is_worker_failure};
+use std::collections::BTreeMap;
+use std::net::SocketAddr;
+use std::time::Duration;
+use tonic::{Code, Status};
+
+/// Why a pool could not be built or set up.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum PoolError {
+    /// Bad configuration (no workers, unparsable address, ...).
+    #[error("pool configuration: {0}")]
+    Config(String),
+    /// A worker refused us (wrong token, protocol version, limits).
+    #[error("worker {worker} refused: {code:?}: {message}")]
+    Refused {
+        /// Its address or name.
+        worker: String,
+        /// The status code.
+        code: Code,
+        /// The status message.
+        message: String,
+    },
+    /// No worker could be used.
+    #[error("no worker available: {0}")]
+    Unavailable(String),
+}
+
+/// TLS towards remote workers (needs the `tls` feature).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ClientTls {
+    /// CA certificate(s) that sign the workers' certificates (PEM).
+    pub ca_pem: Vec<u8>,
+    /// Name the workers' certificates are issued for (checked against them).
+    pub domain: String,
+}
+
+/// How the pool talks to its workers.
+#[derive(Clone, Debug)]
+pub struct PoolConfig {
+    /// Shared secret sent on every call (`COSDEM_TOKEN` / `--token-file` on the CLI).
+    pub token: Option<Token>,
+    /// Connect and handshake timeout.
+    pub connect_timeout: Duration,
+    /// Deadline of every call but SolveBatch.
+    pub call_timeout: Duration,
+    /// Deadline of one SolveBatch (all of a worker's Gauss points for one iteration). A worker
+    /// that misses it is treated as dead. Default 600 s: set it from the expected cost.
+    pub solve_timeout: Duration,
+    /// Largest message either way.
+    pub max_message_bytes: usize,
+    /// Migrate at a step boundary when max load / mean load exceeds this (INFINITY: never).
+    pub rebalance_threshold: f64,
+    /// Threads of the pool's own tokio runtime.
+    pub runtime_threads: usize,
+    /// Relaxation threads of each in-process worker (0 = cores / workers, at least 1).
+    pub in_process_threads: usize,
+    /// TLS to remote workers (needs the `tls` feature; in-process workers never use it).
+    pub tls: Option<ClientTls>,
+}
+
+impl Default for PoolConfig {
+    fn default() -> Self {
+        Self {
+            token: None,
+            connect_timeout: Duration::from_secs(5),
+            call_timeout: Duration::from_secs(60),
+            solve_timeout: Duration::from_secs(600),
+            max_message_bytes: cosdem_proto::DEFAULT_MAX_MESSAGE_BYTES,
+            rebalance_threshold: 1.25,
+            runtime_threads: 2,
+            in_process_threads: 0,
+            tls: None,
+        }
+    }
+}
+
+/// Counters of what happened (for logs and tests).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PoolStats {
+    /// Workers declared dead.
+    pub workers_lost: u64,
+    /// Workers admitted after the start (returned or new).
+    pub workers_admitted: u64,
+    /// Assemblies restored from the master's committed states after a failure.
+    pub restored: u64,
+    /// Assemblies migrated by rebalancing.
+    pub migrated: u64,
+    /// Gauss point solves redone after a failure.
+    pub resolved: u64,
+}
+
+struct Worker {
+    link: Link,
+    addr: Option<SocketAddr>,
+    alive: bool,
+}
+
+/// The DEM-backed material: a set of workers holding one assembly per Gauss point.
+pub struct Pool {
+    rt: Option<tokio::runtime::Runtime>,
+    handle: tokio::runtime::Handle,
+    config: PoolConfig,
+    sources: Vec<String>,
+    workers: Vec<Worker>,
+    owner: BTreeMap<GaussPointId, usize>,
+    committed: BTreeMap<GaussPointId, AssemblyState>,
+    costs: BTreeMap<GaussPointId, Cost>,
+    last: Option<(TrialId, BTreeMap<GaussPointId, MacroDeformation>)>,
+    current_step: Option<u64>,
+    committed_step: u64,
+    stats: PoolStats,
+    _stops: Vec<tokio::sync::oneshot::Sender<()>>,
+}
+
+impl Drop for Pool {
+    fn drop(&mut self) {
+        // Free the assemblies on remote workers (best effort, bounded), unless dropped
+        // inside an async context where blocking is not allowed.
+        if tokio::runtime::Handle::try_current().is_err() && !self.sources.is_empty() {
+            self.release();
+        }
+        // Do not wait for relaxations still running in in-process workers.
+        if let Some(rt) = self.rt.take() {
+            rt.shutdown_background();
+        }
+    }
+}
+
+fn runtime(threads: usize) -> Result<tokio::runtime::Runtime, PoolError> {
+    tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(threads.max(1))
+        .thread_name("cosdem-pool")
+        .enable_all()
+        .build()
+        .map_err(|e| PoolError::Config(format!("tokio runtime: {e}")))
+}
+
+fn refused(worker: &str, s: &Status) -> PoolError {
+    PoolError::Refused { worker: worker.into(), code: s.code(), message: s.message().into() }
+}
+
+async fn resolve(source: &str) -> Vec<SocketAddr> {
+    match tokio::net::lookup_host(source).await {
+        Ok(addrs) => {
+            let mut v: Vec<_> = addrs.collect();
+            v.sort();
+            v.dedup();
+            v
+        }
+        Err(e) => {
+            tracing::warn!(source, error = %e, "cannot resolve worker address");
+            Vec::new()
+        }
+    }
+}
+
+/// One worker's share of a fan-out.
+type Job<T> = std::pin::Pin<Box<dyn Future<Output = Result<T, Status>> + Send>>;
+
+type Outcomes = BTreeMap<GaussPointId, Result<MicroResponse, String>>;
+
+/// Runs one job per worker concurrently; a lost task becomes an INTERNAL status.
+async fn fan_out<T: Send + 'static>(jobs: Vec<(usize, Job<T>)>) -> Vec<(usize, Result<T, Status>)> {
+    let mut set = tokio::task::JoinSet::new();
+    for (w, job) in jobs {
+        set.spawn(async move { (w, job.await) });
+    }
+    let mut out = Vec::new();
+    while let Some(r) = set.join_next().await {
+        match r {
+            Ok(x) => out.push(x),
+            Err(e) => tracing::error!("pool task lost: {e}"),
+        }
+    }
+    out.sort_by_key(|(w, _)| *w);
+    out
+}
+
+impl Pool {
+    /// Connects to workers given as `host:port` (each name may resolve to several addresses,
+    /// one worker each) and shakes hands with each. Unreachable addresses are skipped with a
+    /// warning; a refusal (token, protocol version) is an error; no worker at all is an error.
+    pub fn connect(addresses: &[String], config: PoolConfig) -> Result<Pool, PoolError> {
+        if addresses.is_empty() {
+            return Err(PoolError::Config("no worker addresses given".into()));
+        }
+        let rt = runtime(config.runtime_threads)?;
+        let handle = rt.handle().clone();
+        let mut pool = Pool::empty(rt, handle, config);
+        pool.sources = addresses.to_vec();
+        let public = |a: &SocketAddr| !a.ip().is_loopback();
+        let h = pool.handle.clone();
+        h.block_on(async {
+            let mut addrs = Vec::new();
+            for s in &pool.sources {
+                let found = resolve(s).await;
+                if found.is_empty() {
+                    tracing::warn!(source = %s, "no address for worker");
+                }
+                addrs.extend(found);
+            }
+            if pool.config.token.is_none()
+                && let Some(a) = addrs.iter().find(|a| public(a))
+            {
+                return Err(PoolError::Config(format!(
+                    "worker {a} is not on loopback: a token is required (COSDEM_TOKEN or --token-file)"
+                )));
+            }
+            for addr in addrs {
+                if pool.workers.iter().any(|w| w.addr == Some(addr)) {
+                    continue;
+                }
+                let c = &pool.config;
+                match link::connect_tcp(addr, c).await
+                {
+                    Ok(link) => {
+                        // One master per worker: whatever a previous master left is stale.
+                        let t = c.call_timeout;
+                        link.drop_assemblies(&[], t).await.map_err(|s| refused(&link.name, &s))?;
+                        pool.workers.push(Worker { link, addr: Some(addr), alive: true });
+                    }
+                    Err(s) if matches!(s.code(), Code::Unavailable | Code::DeadlineExceeded) => {
+                        tracing::warn!(%addr, error = %s.message(), "worker unreachable, skipped");
+                    }
+                    Err(s) => return Err(refused(&addr.to_string(), &s)),
+                }
+            }
+            Ok(())
+        })?;
+        if pool.workers.is_empty() {
+            return Err(PoolError::Unavailable(format!("none of {:?} answered", addresses)));
+        }
+        Ok(pool)
+    }
+
+    /// `n` workers inside this process, each a full MicroSolver service reached over an
+    /// in-memory `tokio::io::duplex` transport (the same code path as the network, no port).
+    /// `factory(i)` builds worker `i`'s model. What `cosdem run` uses without `--workers`.
+    pub fn in_process<M: MicroModel>(
+        n: usize,
+        config: PoolConfig,
+        factory: impl Fn(usize) -> M,
+    ) -> Result<Pool, PoolError> {
+        if n == 0 {
+            return Err(PoolError::Config("in-process pool needs at least one worker".into()));
+        }
+        let rt = runtime(config.runtime_threads)?;
+        let handle = rt.handle().clone();
+        let mut pool = Pool::empty(rt, handle, config);
+        let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
+        let threads = if pool.config.in_process_threads > 0 {
+            pool.config.in_process_threads
+        } else {
+            (cores / n).max(1)
+        };
+        for i in 0..n {
+            let (conn_tx, conn_rx) = tokio::sync::mpsc::unbounded_channel();
+            let (stop_tx, stop_rx) = tokio::sync::oneshot::channel::<()>();
+            let wc = WorkerConfig {
+                token: pool.config.token.clone(),
+                threads,
+                limits: Limits {
+                    max_message_bytes: pool.config.max_message_bytes,
+                    ..Limits::default()
+                },
+                ..WorkerConfig::default()
+            };
+            let model = factory(i);
+            pool.handle.spawn(async move {
+                if let Err(e) = serve_duplex(conn_rx, wc, model, async {
+                    let _ = stop_rx.await;
+                })
+                .await
+                {
+                    tracing::error!("in-process worker {i}: {e}");
+                }
+            });
+            let c = &pool.config;
+            let name = format!("in-process worker {i}");
+            let link = pool
+                .handle
+                .block_on(link::connect_duplex(
+                    name.clone(),
+                    conn_tx,
+                    c.token.clone(),
+                    c.connect_timeout,
+                    c.max_message_bytes,
+                ))
+                .map_err(|s| refused(&name, &s))?;
+            pool.workers.push(Worker { link, addr: None, alive: true });
+            pool._stops.push(stop_tx);
+        }
+        Ok(pool)
+    }
+
+    fn empty(
+        rt: tokio::runtime::Runtime,
+        handle: tokio::runtime::Handle,
+        config: PoolConfig,
+    ) -> Pool {
+        Pool {
+            rt: Some(rt),
+            handle,
+            config,
+            sources: Vec::new(),
+            workers: Vec::new(),
+            owner: BTreeMap::new(),
+            committed: BTreeMap::new(),
+            costs: BTreeMap::new(),
+            last: None,
+            current_step: None,
+            committed_step: 0,
+            stats: PoolStats::default(),
+            _stops: Vec::new(),
+        }
+    }
+
+    /// Workers in use now.
+    pub fn live_workers(&self) -> usize {
+        self.workers.iter().filter(|w| w.alive).count()
+    }
+
+    /// What each live worker said at handshake, by name.
+    pub fn workers(&self) -> Vec<(String, WorkerInfo)> {
+        self.workers
+            .iter()
+            .filter(|w| w.alive)
+            .map(|w| (w.link.name.clone(), w.link.info.clone()))
+            .collect()
+    }
+
+    /// Which worker (by name) holds each assembly.
+    pub fn assignment(&self) -> BTreeMap<GaussPointId, String> {
+        self.owner.iter().map(|(id, w)| (*id, self.workers[*w].link.name.clone())).collect()
+    }
+
+    /// Counters of failures, restorations and migrations.
+    pub fn stats(&self) -> PoolStats {
+        self.stats
+    }
+
+    /// The master's copy of each assembly's last committed state.
+    pub fn committed_states(&self) -> &BTreeMap<GaussPointId, AssemblyState> {
+        &self.committed
+    }
+
+    /// Builds one assembly per Gauss point from `spec`, placed by expected cost, and stores
+    /// their initial committed states (step 0) for failover.
+    pub fn create_assemblies(
+        &mut self,
+        ids: &[GaussPointId],
+        spec: &AssemblyRequest,
+    ) -> Result<(), PoolError> {
+        let h = self.handle.clone();
+        h.block_on(self.create_async(ids, spec))
+    }
+
+    /// Frees every assembly on the live workers (best effort, one call timeout at most).
+    /// Called when the pool is dropped; the pool holds no assemblies afterwards.
+    pub fn release(&mut self) {
+        let t = self.config.connect_timeout;
+        let links: Vec<_> =
+            self.workers.iter().filter(|w| w.alive).map(|w| w.link.clone()).collect();
+        self.handle.block_on(async move {
+            for l in links {
+                let _ = l.drop_assemblies(&[], t).await;
+            }
+        });
+        self.owner.clear();
+        self.committed.clear();
+        self.costs.clear();
+        self.last = None;
+    }
+
+    /// Particle-level snapshot of one assembly (committed state).
+    pub fn snapshot(&mut self, id: GaussPointId) -> Result<MicroSnapshot, PoolError> {
+        let w = *self
+            .owner
+            .get(&id)
+            .ok_or_else(|| PoolError::Config(format!("no assembly for {id}")))?;
+        let link = self.workers[w].link.clone();
+        let t = self.config.call_timeout;
+        self.handle.block_on(link.snapshot(id, t)).map_err(|s| refused(&link.name, &s))
+    }
+
+    fn alive(&self) -> Vec<(usize, u32)> {
+        self.workers
+            .iter()
+            .enumerate()
+            .filter(|(_, w)| w.alive)
+            .map(|(i, w)| (i, w.link.info.cores))
+            .collect()
+    }
+
+    fn loads(&self) -> BTreeMap<usize, f64> {
+        let costs = effective_costs(&self.costs);
+        let mut load: BTreeMap<usize, f64> = self.alive().iter().map(|&(w, _)| (w, 0.0)).collect();
+        for (id, w) in &self.owner {
+            if let Some(l) = load.get_mut(w) {
+                *l += costs.get(id).copied().unwrap_or(1.0)
+                    / self.workers[*w].link.info.cores.max(1) as f64;
+            }
+        }
+        load
+    }
+
+    fn owned_by(&self, w: usize) -> Vec<GaussPointId> {
+        self.owner.iter().filter(|(_, o)| **o == w).map(|(id, _)| *id).collect()
+    }
+
+    fn mark_dead(&mut self, w: usize, why: &Status) {
+        if self.workers[w].alive {
+            tracing::warn!(worker = %self.workers[w].link.name, code = ?why.code(), error = %why.message(), "worker lost");
+            self.workers[w].alive = false;
+            self.stats.workers_lost += 1;
+        }
+    }
+
+    async fn create_async(
+        &mut self,
+        ids: &[GaussPointId],
+        spec: &AssemblyRequest,
+    ) -> Result<(), PoolError> {
+        if let Some(id) = ids.iter().find(|id| self.owner.contains_key(id)) {
+            return Err(PoolError::Config(format!("assembly for {id} already created")));
+        }
+        let alive = self.alive();
+        if alive.is_empty() {
+            return Err(PoolError::Unavailable("every worker is lost".into()));
+        }
+        let hint = spec.disc_count_hint.max(1);
+        let mut load = self.loads();
+        let new: Vec<_> = ids.iter().map(|id| (*id, hint as f64)).collect();
+        let mut by_worker: BTreeMap<usize, Vec<GaussPointId>> = BTreeMap::new();
+        for (id, w) in place(&new, &alive, &mut load) {
+            by_worker.entry(w).or_default().push(id);
+        }
+        let t = self.config.call_timeout;
+        let jobs = by_worker
+            .into_iter()
+            .map(|(w, ids)| {
+                let link = self.workers[w].link.clone();
+                let spec = spec.clone();
+                let job: Job<_> = Box::pin(async move {
+                    let infos = link.create(&ids, &spec, t).await?;
+                    let states = link.export(&ids, t).await?;
+                    Ok((infos, states))
+                });
+                (w, job)
+            })
+            .collect();
+        for (w, r) in fan_out(jobs).await {
+            let (infos, states) = r.map_err(|s| refused(&self.workers[w].link.name, &s))?;
+            for i in infos {
+                self.owner.insert(i.id, w);
+                self.costs.insert(i.id, Cost { discs: i.disc_count, seconds: None });
+            }
+            for s in states {
+                self.committed.insert(s.id, s);
+            }
+        }
+        Ok(())
+    }
+
+    /// Imports the stored committed states of `ids` on live workers (by cost), retrying on
+    /// other workers when an import target fails.
+    async fn restore(&mut self, ids: &[GaussPointId]) -> Result<(), MaterialError> {
+        let mut todo: Vec<GaussPointId> = ids.to_vec();
+        while !todo.is_empty() {
+            let alive = self.alive();
+            if alive.is_empty() {
+                return Err(MaterialError::Unavailable("every worker is lost".into()));
+            }
+            // Loads without the assemblies being moved.
+            for id in &todo {
+                self.owner.remove(id);
+            }
+            let costs = effective_costs(&self.costs);
+            let mut load = self.loads();
+            let new: Vec<_> =
+                todo.iter().map(|id| (*id, costs.get(id).copied().unwrap_or(1.0))).collect();
+            let mut by_worker: BTreeMap<usize, Vec<GaussPointId>> = BTreeMap::new();
+            for (id, w) in place(&new, &alive, &mut load) {
+                by_worker.entry(w).or_default().push(id);
+            }
+            let t = self.config.call_timeout;
+            let mut jobs = Vec::new();
+            for (w, ids) in &by_worker {
+                let states: Vec<_> = ids.iter().map(|id| self.committed[id].clone()).collect();
+                let link = self.workers[*w].link.clone();
+                let job: Job<_> = Box::pin(async move { link.import(states, t).await });
+                jobs.push((*w, job));
+            }
+            todo.clear();
+            for (w, r) in fan_out(jobs).await {
+                let ids = &by_worker[&w];
+                match r {
+                    Ok(()) => {
+                        for id in ids {
+                            self.owner.insert(*id, w);
+                        }
+                        self.stats.restored += ids.len() as u64;
+                        tracing::info!(worker = %self.workers[w].link.name, n = ids.len(), "assemblies restored");
+                    }
+                    Err(s) if is_worker_failure(&s) || s.code() == Code::ResourceExhausted => {
+                        self.mark_dead(w, &s);
+                        todo.extend(self.owned_by(w));
+                        todo.extend(ids);
+                    }
+                    Err(s) => {
+                        return Err(MaterialError::Unavailable(format!(
+                            "restore on {}: {}",
+                            self.workers[w].link.name,
+                            s.message()
+                        )));
+                    }
+                }
+            }
+            todo.sort();
+            todo.dedup();
+        }
+        Ok(())
+    }
+
+    /// Solves `targets` at `trial` wherever their assemblies are, moving the assemblies of
+    /// failed workers and solving them again until every Gauss point has an answer.
+    async fn solve_all(
+        &mut self,
+        trial: TrialId,
+        targets: &BTreeMap<GaussPointId, MacroDeformation>,
+    ) -> Result<Outcomes, MaterialError> {
+        let mut pending: Vec<GaussPointId> = targets.keys().copied().collect();
+        let mut out = Outcomes::new();
+        let mut first = true;
+        while !pending.is_empty() {
+            if !first {
+                self.stats.resolved += pending.len() as u64;
+            }
+            first = false;
+            let mut by_worker: BTreeMap<usize, Vec<(GaussPointId, MacroDeformation)>> =
+                BTreeMap::new();
+            for id in &pending {
+                by_worker.entry(self.owner[id]).or_default().push((*id, targets[id]));
+            }
+            let t = self.config.solve_timeout;
+            let jobs = by_worker
+                .into_iter()
+                .map(|(w, items)| {
+                    let link = self.workers[w].link.clone();
+                    let job: Job<_> =
+                        Box::pin(
+                            async move { link.solve(trial.step, trial.iteration, items, t).await },
+                        );
+                    (w, job)
+                })
+                .collect();
+            let mut lost = Vec::new();
+            for (w, r) in fan_out(jobs).await {
+                match r {
+                    Ok(results) => out.extend(results),
+                    Err(s) if is_worker_failure(&s) => {
+                        self.mark_dead(w, &s);
+                        lost.extend(self.owned_by(w));
+                    }
+                    Err(s) => {
+                        return Err(MaterialError::Unavailable(format!(
+                            "worker {}: {:?}: {}",
+                            self.workers[w].link.name,
+                            s.code(),
+                            s.message()
+                        )));
+                    }
+                }
+            }
+            if lost.is_empty() {
+                break;
+            }
+            self.restore(&lost).await?;
+            // Everything that lived on a lost worker has lost its trial: solve it again.
+            pending = lost.into_iter().filter(|id| targets.contains_key(id)).collect();
+        }
+        Ok(out)
+    }
+
+    async fn evaluate_async(
+        &mut self,
+        trial: TrialId,
+        inputs: &[MaterialInput],
+    ) -> Result<Vec<MicroResponse>, MaterialError> {
+        let mut targets = BTreeMap::new();
+        let mut bad = Vec::new();
+        for input in inputs {
+            let id = input.gauss_point;
+            if !self.owner.contains_key(&id) {
+                return Err(MaterialError::Unavailable(format!(
+                    "no assembly for {id}: call Pool::create_assemblies first"
+                )));
+            }
+            if let Err(e) = input.deformation.validate() {
+                bad.push((id, e.to_string()));
+            }
+            if targets.insert(id, input.deformation).is_some() {
+                return Err(MaterialError::Unavailable(format!(
+                    "{id} appears twice in one evaluation"
+                )));
+            }
+        }
+        if !bad.is_empty() {
+            return Err(MaterialError::GaussPoints(bad));
+        }
+        if self.current_step != Some(trial.step) {
+            self.step_boundary().await?;
+            self.current_step = Some(trial.step);
+        }
+        let mut out = self.solve_all(trial, &targets).await?;
+        self.last = Some((trial, targets));
+        let mut responses = Vec::with_capacity(inputs.len());
+        let mut failed = Vec::new();
+        for input in inputs {
+            match out.remove(&input.gauss_point) {
+                Some(Ok(r)) => {
+                    if let Some(c) = self.costs.get_mut(&input.gauss_point) {
+                        // Smoothed, so that timing noise does not shuffle assemblies.
+                        let t = r.diagnostics.wall_seconds;
+                        c.seconds = Some(c.seconds.map_or(t, |old| 0.5 * (old + t)));
+                    }
+                    responses.push(r);
+                }
+                Some(Err(e)) => failed.push((input.gauss_point, e)),
+                None => failed.push((input.gauss_point, "no answer from its worker".into())),
+            }
+        }
+        if failed.is_empty() { Ok(responses) } else { Err(MaterialError::GaussPoints(failed)) }
+    }
+
+    async fn commit_async(&mut self, step: u64) -> Result<(), MaterialError> {
+        let Some((trial, targets)) = self.last.clone() else {
+            if step <= self.committed_step {
+                return Ok(());
+            }
+            return Err(MaterialError::Unavailable(format!(
+                "commit of step {step} without an evaluation"
+            )));
+        };
+        if trial.step != step {
+            return Err(MaterialError::Unavailable(format!(
+                "commit of step {step}, but the last trial is of step {}",
+                trial.step
+            )));
+        }
+        let mut pending: Vec<GaussPointId> = targets.keys().copied().collect();
+        while !pending.is_empty() {
+            let mut by_worker: BTreeMap<usize, Vec<GaussPointId>> = BTreeMap::new();
+            for id in &pending {
+                by_worker.entry(self.owner[id]).or_default().push(*id);
+            }
+            let t = self.config.call_timeout;
+            let jobs = by_worker
+                .into_iter()
+                .map(|(w, ids)| {
+                    let link = self.workers[w].link.clone();
+                    let job: Job<_> =
+                        Box::pin(async move { link.commit(&ids, step, trial.iteration, t).await });
+                    (w, job)
+                })
+                .collect();
+            let mut lost = Vec::new();
+            for (w, r) in fan_out(jobs).await {
+                match r {
+                    Ok(states) => {
+                        for s in states {
+                            self.committed.insert(s.id, s);
+                        }
+                    }
+                    Err(s) if is_worker_failure(&s) => {
+                        self.mark_dead(w, &s);
+                        lost.extend(self.owned_by(w));
+                    }
+                    Err(s) => {
+                        return Err(MaterialError::Unavailable(format!(
+                            "commit on {}: {:?}: {}",
+                            self.workers[w].link.name,
+                            s.code(),
+                            s.message()
+                        )));
+                    }
+                }
+            }
+            if lost.is_empty() {
+                break;
+            }
+            self.restore(&lost).await?;
+            // Those not committed yet lost their trial with their worker: solve it again.
+            let redo: BTreeMap<_, _> = lost
+                .iter()
+                .filter(|id| self.committed[id].committed_step < step)
+                .filter_map(|id| targets.get(id).map(|t| (*id, *t)))
+                .collect();
+            let again = self.solve_all(trial, &redo).await?;
+            if let Some((id, e)) =
+                again.iter().find_map(|(id, r)| r.as_ref().err().map(|e| (id, e)))
+            {
+                return Err(MaterialError::GaussPoints(vec![(
+                    *id,
+                    format!("re-solve after worker loss failed: {e}"),
+                )]));
+            }
+            pending = redo.keys().copied().collect();
+        }
+        self.committed_step = step;
+        self.last = None;
+        Ok(())
+    }
+
+    async fn rollback_async(&mut self) -> Result<(), MaterialError> {
+        self.last = None;
+        let mut by_worker: BTreeMap<usize, Vec<GaussPointId>> = BTreeMap::new();
+        for (id, w) in &self.owner {
+            by_worker.entry(*w).or_default().push(*id);
+        }
+        let t = self.config.call_timeout;
+        let jobs = by_worker
+            .into_iter()
+            .map(|(w, ids)| {
+                let link = self.workers[w].link.clone();
+                let job: Job<_> = Box::pin(async move { link.rollback(&ids, t).await });
+                (w, job)
+            })
+            .collect();
+        let mut lost = Vec::new();
+        for (w, r) in fan_out(jobs).await {
+            match r {
+                Ok(()) => {}
+                Err(s) if is_worker_failure(&s) => {
+                    self.mark_dead(w, &s);
+                    lost.extend(self.owned_by(w));
+                }
+                Err(s) => {
+                    return Err(MaterialError::Unavailable(format!(
+                        "rollback on {}: {}",
+                        self.workers[w].link.name,
+                        s.message()
+                    )));
+                }
+            }
+        }
+        // A restored assembly holds its committed state only: exactly a rollback.
+        self.restore(&lost).await
+    }
+
+    /// At a new load step: admit returned or new workers, then rebalance.
+    async fn step_boundary(&mut self) -> Result<(), MaterialError> {
+        self.admit().await;
+        let costs = effective_costs(&self.costs);
+        let moves = rebalance(&self.owner, &costs, &self.alive(), self.config.rebalance_threshold);
+        if moves.is_empty() {
+            return Ok(());
+        }
+        let mut by_dest: BTreeMap<usize, Vec<(GaussPointId, usize)>> = BTreeMap::new();
+        for (id, from, to) in moves {
+            by_dest.entry(to).or_default().push((id, from));
+        }
+        let t = self.config.call_timeout;
+        let mut jobs = Vec::new();
+        for (to, list) in &by_dest {
+            let states: Vec<_> = list.iter().map(|(id, _)| self.committed[id].clone()).collect();
+            let link = self.workers[*to].link.clone();
+            let job: Job<_> = Box::pin(async move { link.import(states, t).await });
+            jobs.push((*to, job));
+        }
+        let mut lost = Vec::new();
+        let mut drops: BTreeMap<usize, Vec<GaussPointId>> = BTreeMap::new();
+        for (to, r) in fan_out(jobs).await {
+            match r {
+                Ok(()) => {
+                    for (id, from) in &by_dest[&to] {
+                        self.owner.insert(*id, to);
+                        drops.entry(*from).or_default().push(*id);
+                        self.stats.migrated += 1;
+                    }
+                }
+                Err(s) if is_worker_failure(&s) => {
+                    self.mark_dead(to, &s);
+                    lost.extend(self.owned_by(to));
+                }
+                // A full destination keeps nothing new; the assemblies stay where they are.
+                Err(s) => {
+                    tracing::warn!(worker = %self.workers[to].link.name, error = %s.message(), "migration refused")
+                }
+            }
+        }
+        for (from, ids) in drops {
+            if let Err(s) = self.workers[from].link.drop_assemblies(&ids, t).await {
+                tracing::warn!(worker = %self.workers[from].link.name, error = %s.message(), "drop after migration failed");
+            }
+        }
+        self.restore(&lost).await
+    }
+
+    /// Re-resolves the worker addresses; an address with no live worker (returned or new)
+    /// is admitted if it answers the handshake and is idle, after dropping whatever it holds.
+    async fn admit(&mut self) {
+        if self.sources.is_empty() {
+            return;
+        }
+        let mut addrs = Vec::new();
+        for s in &self.sources {
+            addrs.extend(resolve(s).await);
+        }
+        for addr in addrs {
+            if self.workers.iter().any(|w| w.alive && w.addr == Some(addr)) {
+                continue;
+            }
+            let c = &self.config;
+            let Ok(link) = link::connect_tcp(addr, c).await else {
+                continue;
+            };
+            match link.health(c.connect_timeout).await {
+                Ok((_, _, 0)) => {}
+                _ => continue,
+            }
+            if link.drop_assemblies(&[], c.connect_timeout).await.is_err() {
+                continue;
+            }
+            tracing::info!(%addr, "worker admitted");
+            self.stats.workers_admitted += 1;
+            match self.workers.iter_mut().find(|w| w.addr == Some(addr)) {
+                Some(w) => {
+                    w.link = link;
+                    w.alive = true;
+                }
+                None => self.workers.push(Worker { link, addr: Some(addr), alive: true }),
+            }
+        }
+    }
+}
+
+impl Material for Pool {
+    fn evaluate(
+        &mut self,
+        trial: TrialId,
+        inputs: &[MaterialInput],
+    ) -> Result<Vec<MicroResponse>, MaterialError> {
+        let h = self.handle.clone();
+        h.block_on(self.evaluate_async(trial, inputs))
+    }
+
+    fn commit(&mut self, step: u64) -> Result<(), MaterialError> {
+        let h = self.handle.clone();
+        h.block_on(self.commit_async(step))
+    }
+
+    fn rollback(&mut self) -> Result<(), MaterialError> {
+        let h = self.handle.clone();
+        h.block_on(self.rollback_async())
+    }
+}

@@ -1,0 +1,54 @@
+//! A worker process killed with SIGKILL in the middle of a step (between Newton iterations,
+//! and between the last iteration and the commit): the job completes, bit-identical.
+
+mod common;
+use common::*;
+use cosdem_master::pool::Pool;
+
+#[test]
+fn killed_workers_are_replaced_and_results_are_bit_identical() {
+    let reference = reference(100, 20);
+    let mut procs: Vec<_> = (0..3).map(|_| WorkerProcess::start(&[], &[])).collect();
+    let addrs: Vec<String> = procs.iter().map(|p| p.addr.to_string()).collect();
+    let mut pool = Pool::connect(&addrs, test_config()).unwrap();
+    create(&mut pool, 100, 20);
+    let trace = run_program(&mut pool, &mut |step, iteration| {
+        // Mid-step: the next evaluation finds worker 0 gone.
+        if (step, iteration) == (2, 1) {
+            procs[0].kill();
+        }
+        // After the last iteration of step 4: the commit finds worker 1 gone, its points
+        // are re-solved from their stored states elsewhere and committed there.
+        if (step, iteration) == (4, 2) {
+            procs[1].kill();
+        }
+    });
+    assert_identical(&reference, &trace);
+    let stats = pool.stats();
+    assert_eq!(stats.workers_lost, 2, "{stats:?}");
+    assert!(stats.restored > 0 && stats.resolved > 0, "{stats:?}");
+    assert_eq!(pool.live_workers(), 1);
+}
+
+#[test]
+fn a_killed_worker_during_a_batch_is_replaced() {
+    // Slow solves (about 10 ms each) so that the kill lands while the batch is running.
+    let reference = reference(1000, 1000);
+    let mut procs: Vec<_> = (0..2).map(|_| WorkerProcess::start(&[], &[])).collect();
+    let addrs: Vec<String> = procs.iter().map(|p| p.addr.to_string()).collect();
+    let mut pool = Pool::connect(&addrs, test_config()).unwrap();
+    create(&mut pool, 1000, 1000);
+    let mut victim = Some(procs.remove(1));
+    let trace = run_program(&mut pool, &mut |step, iteration| {
+        if (step, iteration) == (2, 0)
+            && let Some(mut p) = victim.take()
+        {
+            std::thread::spawn(move || {
+                std::thread::sleep(std::time::Duration::from_millis(15));
+                p.kill();
+            });
+        }
+    });
+    assert_identical(&reference, &trace);
+    assert_eq!(pool.stats().workers_lost, 1);
+}

@@ -1,0 +1,148 @@
+//! The worker's gRPC service (`cosdem.v1.MicroSolver`) around a [`MicroModel`].
+//!
+//! - [`serve`] listens on TCP until a shutdown future resolves (use [`shutdown_signal`] for
+//!   SIGTERM / Ctrl-C); [`serve_listener`] takes a bound listener (tests bind port 0);
+//!   [`serve_duplex`] serves in-memory `tokio::io::duplex` connections (in-process workers).
+//! - The shared secret is checked on every MicroSolver call by [`CheckToken`]; the standard
+//!   `grpc.health.v1.Health` service (tonic-health) answers readiness probes without one.
+//! - Status codes (mapped in one place, `error.rs`): unknown id NOT_FOUND, NaN or
+//!   det(F) <= 0 INVALID_ARGUMENT naming field and value, protocol version mismatch
+//!   FAILED_PRECONDITION naming both, over the assembly or disc limits RESOURCE_EXHAUSTED,
+//!   an oversized message OUT_OF_RANGE (tonic's code, raised before the service runs),
+//!   missing or wrong token UNAUTHENTICATED. A failed relaxation is not a status: it comes
+//!   back in-band in its `SolveResult`.
+//! - TLS (feature `tls`, rustls with ring): [`WorkerConfig::tls`] / `--tls-cert --tls-key`.
+
+mod auth;
+mod config;
+/// The real micro model: DEM assemblies.
+pub mod dem;
+mod error;
+mod model;
+mod registry;
+mod server;
+mod standin;
+
+pub use auth::{AttachToken, CheckToken, TOKEN_ENV, Token};
+pub use config::{Limits, ListenArgs, TlsIdentity, WorkerConfig};
+pub use dem::Dem;
+pub use error::{Result, ServiceError};
+pub use model::{MicroModel, ModelError};
+pub use server::WorkerService;
+pub use standin::{StandIn, StandInAssembly, StandInOptions, StandInSpec};
+
+use cosdem_proto::v1::micro_solver_server::MicroSolverServer;
+use std::future::Future;
+use std::net::SocketAddr;
+use tokio::net::TcpListener;
+use tonic::service::interceptor::InterceptedService;
+use tonic::transport::Server;
+use tonic::transport::server::Router;
+
+/// What a worker reports as its build at handshake.
+pub const BUILD_ID: &str = concat!("cosdem-worker ", env!("CARGO_PKG_VERSION"));
+
+/// Interval of HTTP/2 keepalive pings (so a master notices a dead peer between calls).
+const KEEPALIVE: std::time::Duration = std::time::Duration::from_secs(10);
+
+async fn router<M: MicroModel>(model: M, config: &WorkerConfig) -> Result<Router> {
+    let (reporter, health) = tonic_health::server::health_reporter();
+    let max = config.limits.max_message_bytes;
+    let service = MicroSolverServer::new(WorkerService::new(model, config.clone())?)
+        .max_decoding_message_size(max)
+        .max_encoding_message_size(max);
+    reporter.set_serving::<MicroSolverServer<WorkerService<M>>>().await;
+    #[allow(unused_mut)]
+    let mut builder = Server::builder();
+    #[cfg(feature = "tls")]
+    if let Some(tls) = &config.tls {
+        use tonic::transport::{Identity, ServerTlsConfig};
+        let identity = Identity::from_pem(&tls.cert_pem, &tls.key_pem);
+        builder = builder
+            .tls_config(ServerTlsConfig::new().identity(identity))
+            .map_err(|e| ServiceError::Config(format!("TLS: {e}")))?;
+    }
+    Ok(builder
+        .http2_keepalive_interval(Some(KEEPALIVE))
+        .add_service(health)
+        .add_service(InterceptedService::new(service, CheckToken(config.token.clone()))))
+}
+
+/// Binds `config.listen`, after refusing a public address without a token.
+pub async fn bind(config: &WorkerConfig) -> Result<TcpListener> {
+    config.validate()?;
+    TcpListener::bind(config.listen)
+        .await
+        .map_err(|e| ServiceError::Transport(format!("bind {}: {e}", config.listen)))
+}
+
+/// Serves `model` on `config.listen` until `shutdown` resolves (then drains in-flight calls).
+pub async fn serve<M: MicroModel>(
+    config: WorkerConfig,
+    model: M,
+    shutdown: impl Future<Output = ()>,
+) -> Result<()> {
+    let listener = bind(&config).await?;
+    serve_listener(listener, config, model, shutdown).await
+}
+
+/// Serves on an already bound listener (tests bind port 0 and read the address first).
+pub async fn serve_listener<M: MicroModel>(
+    listener: TcpListener,
+    config: WorkerConfig,
+    model: M,
+    shutdown: impl Future<Output = ()>,
+) -> Result<()> {
+    config.validate()?;
+    let addr: Option<SocketAddr> = listener.local_addr().ok();
+    tracing::info!(?addr, auth = config.token.is_some(), "cosdem worker listening");
+    let incoming = tokio_stream::wrappers::TcpListenerStream::new(listener);
+    router(model, &config)
+        .await?
+        .serve_with_incoming_shutdown(incoming, shutdown)
+        .await
+        .map_err(|e| ServiceError::Transport(e.to_string()))
+}
+
+/// Serves in-memory connections: each `DuplexStream` received is one client connection.
+/// No address, no port: what in-process workers and tests use.
+pub async fn serve_duplex<M: MicroModel>(
+    connections: tokio::sync::mpsc::UnboundedReceiver<tokio::io::DuplexStream>,
+    config: WorkerConfig,
+    model: M,
+    shutdown: impl Future<Output = ()>,
+) -> Result<()> {
+    use tokio_stream::StreamExt;
+    // In memory, in one process: no TLS.
+    let config = WorkerConfig { tls: None, ..config };
+    let incoming = tokio_stream::wrappers::UnboundedReceiverStream::new(connections)
+        .map(Ok::<_, std::io::Error>);
+    router(model, &config)
+        .await?
+        .serve_with_incoming_shutdown(incoming, shutdown)
+        .await
+        .map_err(|e| ServiceError::Transport(e.to_string()))
+}
+
+/// Resolves on SIGTERM or Ctrl-C: the shutdown future a worker binary passes to [`serve`].
+pub async fn shutdown_signal() {
+    let ctrl_c = async {
+        let _ = tokio::signal::ctrl_c().await;
+    };
+    #[cfg(unix)]
+    let term = async {
+        match tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate()) {
+            Ok(mut s) => {
+                s.recv().await;
+            }
+            Err(_) => std::future::pending::<()>().await,
+        }
+    };
+    #[cfg(not(unix))]
+    let term = std::future::pending::<()>();
+    tokio::select! {
+        _ = ctrl_c => {},
+        _ = term => {},
+    }
+    tracing::info!("shutdown requested: draining");
+}
