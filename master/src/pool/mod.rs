@@ -453,6 +453,16 @@ impl Pool {
         self.owner.iter().filter(|(_, o)| **o == w).map(|(id, _)| *id).collect()
     }
 
+    /// The error for a worker that answered with a status that is not a worker failure.
+    fn unavailable(&self, w: usize, call: &str, status: &Status) -> MaterialError {
+        MaterialError::Unavailable(format!(
+            "{call} on {}: {:?}: {}",
+            self.workers[w].link.name,
+            status.code(),
+            status.message()
+        ))
+    }
+
     fn mark_dead(&mut self, w: usize, why: &Status) {
         if self.workers[w].alive {
             tracing::warn!(worker = %self.workers[w].link.name, code = ?why.code(), error = %why.message(), "worker lost");
@@ -608,12 +618,7 @@ impl Pool {
                         lost.extend(self.owned_by(w));
                     }
                     Err(s) => {
-                        return Err(MaterialError::Unavailable(format!(
-                            "worker {}: {:?}: {}",
-                            self.workers[w].link.name,
-                            s.code(),
-                            s.message()
-                        )));
+                        return Err(self.unavailable(w, "solve", &s));
                     }
                 }
             }
@@ -722,12 +727,7 @@ impl Pool {
                         lost.extend(self.owned_by(w));
                     }
                     Err(s) => {
-                        return Err(MaterialError::Unavailable(format!(
-                            "commit on {}: {:?}: {}",
-                            self.workers[w].link.name,
-                            s.code(),
-                            s.message()
-                        )));
+                        return Err(self.unavailable(w, "commit", &s));
                     }
                 }
             }
