@@ -5,14 +5,14 @@
  * a line-based TCP exchange instead of gRPC, and a fake deterministic "solution".
  *
  *   standin listen --listen ADDR [--token-file PATH]      (token also from COSDEM_TOKEN)
- *   standin health --addr HOST:PORT [--token-file PATH]
+ *   standin health --addr HOST:PORT                        (no token, like the real one)
  *   standin run JOB.toml [--workers LIST] --out DIR [--token-file PATH]
  *
  * LIST: comma-separated host:port or dns:NAME:PORT (every address of NAME). Each step
  * must be confirmed by one live worker (tried in turn, 1 s connect/read timeout), else
  * the run fails. Steps: "steps = N" in the job file (default 8); STANDIN_STEP_MS sets the
  * time per step (default 700). Outputs: curve.csv, vtk/step_NNNN.vtu, fields.pvd,
- * summary.json, identical with or without workers (summary.json aside).
+ * gauss.pvd, summary.json, identical with or without workers (summary.json aside).
  */
 #define _GNU_SOURCE
 #include <arpa/inet.h>
@@ -216,13 +216,16 @@ static int cmd_run(int argc, char **argv) {
         fprintf(stderr, "step %d/%d\n", k, steps);
     }
     fclose(curve);
-    snprintf(path, sizeof path, "%s/fields.pvd", out);
-    FILE *p = fopen(path, "w");
-    if (!p) return 1;
-    fprintf(p, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\"><Collection>\n");
-    for (int k = 1; k <= steps; k++) fprintf(p, "<DataSet timestep=\"%d\" file=\"vtk/step_%04d.vtu\"/>\n", k, k);
-    fprintf(p, "</Collection></VTKFile>\n");
-    fclose(p);
+    static const char *const pvds[] = {"fields.pvd", "gauss.pvd"};
+    for (int i = 0; i < 2; i++) {
+        snprintf(path, sizeof path, "%s/%s", out, pvds[i]);
+        FILE *p = fopen(path, "w");
+        if (!p) return 1;
+        fprintf(p, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\"><Collection>\n");
+        for (int k = 1; k <= steps; k++) fprintf(p, "<DataSet timestep=\"%d\" file=\"vtk/step_%04d.vtu\"/>\n", k, k);
+        fprintf(p, "</Collection></VTKFile>\n");
+        fclose(p);
+    }
     snprintf(path, sizeof path, "%s/summary.json", out);
     FILE *s = fopen(path, "w");
     if (!s) return 1;
