@@ -35,6 +35,8 @@
 
 /// From nodal fields to Gauss-point kinematics and back to global residual and tangent.
 pub mod assembly;
+/// Benchmarks of the coupling (RPC overhead, worker scaling, FE versus DEM cost): `cosdem bench`.
+pub mod bench;
 /// Reference elements: Q8/Q9 shape functions and Gauss rules.
 pub mod element;
 /// The crate's error type.

@@ -2,7 +2,10 @@
 //!
 //! ```text
 //! cosdem run JOB.toml [--workers LIST] [--out DIR] [--token-file FILE]
+//! cosdem bench overhead|scaling|fe|all [OPTIONS]
 //! ```
+//! `bench` prints the coupling benchmarks of `cosdem_master::bench` (build with `--release`;
+//! the TCP runs start the `cosdem-worker` binary found next to `cosdem`).
 //! With no workers given, the DEM assemblies are solved by in-process workers (no servers to
 //! start). The run directory is written as the run goes (see `cosdem_master::output::run_dir`).
 
@@ -10,6 +13,7 @@ use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use cosdem_common::GaussPointId;
 use cosdem_common::micro::{AssemblyRequest, BoundaryKind};
+use cosdem_master::bench::{Workload, fe_versus_dem, overhead, scaling, worker_binary};
 use cosdem_master::job::{Job, MaterialSection};
 use cosdem_master::material::{ElasticCosserat, Material};
 use cosdem_master::output::run_dir::{RunSettings, RunWriter};
@@ -31,6 +35,112 @@ struct Cli {
 enum Command {
     /// Run a job file.
     Run(RunArgs),
+    /// Benchmarks of the coupling (see `cosdem_master::bench`): printed figures.
+    Bench {
+        #[command(subcommand)]
+        what: BenchWhat,
+    },
+}
+
+#[derive(Subcommand)]
+enum BenchWhat {
+    /// RPC overhead per Gauss point per iteration: direct vs in-process pool vs loopback TCP.
+    Overhead(OverheadArgs),
+    /// Step time of a 64-Gauss-point job with 1 and 2 workers of one thread each.
+    Scaling(ScalingArgs),
+    /// FE cost of one Newton iteration against the DEM cost of the same iteration.
+    Fe(FeArgs),
+    /// All three with their defaults.
+    All(CommonArgs),
+}
+
+#[derive(clap::Args, Clone)]
+struct CommonArgs {
+    /// Repetitions of every measurement.
+    #[arg(long, default_value_t = 3)]
+    repeats: usize,
+    /// The `cosdem-worker` binary for the TCP runs (default: next to this executable).
+    #[arg(long)]
+    worker_bin: Option<PathBuf>,
+    /// Skip the TCP runs.
+    #[arg(long)]
+    no_tcp: bool,
+}
+
+#[derive(clap::Args)]
+struct OverheadArgs {
+    /// About this many discs per assembly.
+    #[arg(long, default_value_t = 400)]
+    discs: usize,
+    /// Gauss points (assemblies).
+    #[arg(long, default_value_t = 4)]
+    points: usize,
+    /// Iterations (load steps) per run.
+    #[arg(long, default_value_t = 10)]
+    iterations: u64,
+    #[command(flatten)]
+    common: CommonArgs,
+}
+
+#[derive(clap::Args)]
+struct ScalingArgs {
+    /// About this many discs per assembly.
+    #[arg(long, default_value_t = 400)]
+    discs: usize,
+    /// Gauss points (assemblies).
+    #[arg(long, default_value_t = 64)]
+    points: usize,
+    /// Iterations (load steps) per run.
+    #[arg(long, default_value_t = 2)]
+    iterations: u64,
+    #[command(flatten)]
+    common: CommonArgs,
+}
+
+#[derive(clap::Args)]
+struct FeArgs {
+    /// Elements per side of the Q8 panel.
+    #[arg(long, default_value_t = 10)]
+    elements: usize,
+    /// About this many discs per DEM assembly.
+    #[arg(long, default_value_t = 105)]
+    discs: usize,
+    /// DEM iterations per measurement.
+    #[arg(long, default_value_t = 10)]
+    iterations: u64,
+    /// Repetitions.
+    #[arg(long, default_value_t = 3)]
+    repeats: usize,
+}
+
+fn workload(discs: usize, points: usize, iterations: u64, c: &CommonArgs) -> Result<Workload> {
+    let worker_bin = if c.no_tcp {
+        None
+    } else {
+        Some(worker_binary(c.worker_bin.as_deref()).map_err(|e| anyhow::anyhow!("{e}"))?)
+    };
+    Ok(Workload { discs, points, iterations, repeats: c.repeats, worker_bin })
+}
+
+fn bench(what: BenchWhat) -> Result<()> {
+    let out = &mut std::io::stdout();
+    let e = |e: Box<dyn std::error::Error + Send + Sync>| anyhow::anyhow!("{e}");
+    match what {
+        BenchWhat::Overhead(a) => {
+            overhead(&workload(a.discs, a.points, a.iterations, &a.common)?, out).map_err(e)
+        }
+        BenchWhat::Scaling(a) => {
+            scaling(&workload(a.discs, a.points, a.iterations, &a.common)?, out).map_err(e)
+        }
+        BenchWhat::Fe(a) => {
+            fe_versus_dem(a.elements, a.discs, a.iterations, a.repeats, out).map_err(e)
+        }
+        BenchWhat::All(c) => {
+            overhead(&workload(400, 4, 10, &c)?, out).map_err(e)?;
+            scaling(&workload(400, 64, 2, &c)?, out).map_err(e)?;
+            fe_versus_dem(10, 105, 10, c.repeats, out).map_err(e)
+        }
+    }
 }
 
 #[derive(clap::Args)]
@@ -221,5 +331,6 @@ fn main() -> Result<()> {
     let cli = Cli::parse();
     match cli.command {
         Command::Run(args) => run(args),
+        Command::Bench { what } => bench(what),
     }
 }

@@ -96,7 +96,18 @@ pub async fn serve_listener<M: MicroModel>(
     config.validate()?;
     let addr: Option<SocketAddr> = listener.local_addr().ok();
     tracing::info!(?addr, auth = config.token.is_some(), "cosdem worker listening");
-    let incoming = tokio_stream::wrappers::TcpListenerStream::new(listener);
+    use tokio_stream::StreamExt;
+    // Replies are several small HTTP/2 frames (a SolveBatch streams one message per Gauss
+    // point): with Nagle's algorithm each waits for the master's delayed ACK (~40 ms on Linux).
+    // `Server::tcp_nodelay` only applies to listeners tonic binds itself, so set it here.
+    let incoming = tokio_stream::wrappers::TcpListenerStream::new(listener).map(|s| {
+        if let Ok(s) = &s
+            && let Err(e) = s.set_nodelay(true)
+        {
+            tracing::warn!("TCP_NODELAY: {e}");
+        }
+        s
+    });
     router(model, &config)
         .await?
         .serve_with_incoming_shutdown(incoming, shutdown)
