@@ -4,32 +4,16 @@
 //!
 //! Run: `cargo bench -p cosdem-master --bench newton_iteration`.
 
-use cosdem_master::assembly::{Component, Field};
-use cosdem_master::element::{ElementKind, QuadratureRule};
-use cosdem_master::material::ElasticCosserat;
-use cosdem_master::mesh::Mesh;
-use cosdem_master::solve::{Dirichlet, IterationTiming, Loading, Model, Solver, SolverSettings};
+use cosdem_master::solve::IterationTiming;
 use std::time::Instant;
 
 fn main() {
     let args: Vec<usize> = std::env::args().skip(1).filter_map(|a| a.parse().ok()).collect();
     let sizes = if args.is_empty() { vec![10, 50, 200] } else { args };
     for n in sizes {
-        let mesh = Mesh::rectangle(ElementKind::Q8, 1.0, 1.0, n, n, [0.0, 0.0]).unwrap();
-        let loading = Loading {
-            dirichlet: vec![
-                Dirichlet::new("bottom", Component::Ux, 0.0),
-                Dirichlet::new("bottom", Component::Uy, 0.0),
-                Dirichlet::new("top", Component::Ux, 0.0),
-                Dirichlet::new("top", Component::Uy, -0.01),
-            ],
-            ..Default::default()
-        };
-        let model = Model { mesh, field: Field::Cosserat, rule: QuadratureRule::Gauss2x2, loading };
         let t = Instant::now();
-        let mut solver = Solver::new(model, SolverSettings::default()).unwrap();
+        let (mut solver, mut mat) = cosdem_master::bench::fe_panel(n).unwrap();
         let setup = t.elapsed().as_secs_f64() * 1e3;
-        let mut mat = ElasticCosserat::new(1e7, 0.3, 5e6, 0.01);
         let first = solver.iteration_work(&mut mat).unwrap(); // includes the symbolic analysis
         let reps = if n >= 200 { 3 } else { 10 };
         let mut sum = IterationTiming::default();

@@ -515,10 +515,10 @@ pub fn scaling(w: &Workload, out: &mut dyn Write) -> BenchResult<()> {
     Ok(())
 }
 
-/// The FE cost of one Newton iteration on the `n x n` Q8 panel (2x2 Gauss points, elastic
-/// Cosserat material), averaged over `reps` iterations after a first one that includes the
-/// symbolic analysis. Returns (free dofs, Gauss points, seconds per iteration).
-pub fn fe_iteration(n: usize, reps: usize) -> BenchResult<(usize, usize, f64)> {
+/// The FE benchmark scene: the unit panel meshed `n x n` with Q8 and 2x2 Gauss points, rough
+/// platens, top moved down by 1 cm, and its elastic Cosserat material (G = 1e7 Pa, nu = 0.3,
+/// Gc = 5e6 Pa, lc = 0.01 m). Shared by `fe_iteration` and `benches/newton_iteration.rs`.
+pub fn fe_panel(n: usize) -> crate::Result<(Solver, ElasticCosserat)> {
     let mesh = Mesh::rectangle(ElementKind::Q8, 1.0, 1.0, n, n, [0.0, 0.0])?;
     let loading = Loading {
         dirichlet: vec![
@@ -530,8 +530,15 @@ pub fn fe_iteration(n: usize, reps: usize) -> BenchResult<(usize, usize, f64)> {
         ..Default::default()
     };
     let model = Model { mesh, field: Field::Cosserat, rule: QuadratureRule::Gauss2x2, loading };
-    let mut solver = Solver::new(model, SolverSettings::default())?;
-    let mut mat = ElasticCosserat::new(1e7, 0.3, 5e6, 0.01);
+    let solver = Solver::new(model, SolverSettings::default())?;
+    Ok((solver, ElasticCosserat::new(1e7, 0.3, 5e6, 0.01)))
+}
+
+/// The FE cost of one Newton iteration on the `n x n` Q8 panel (2x2 Gauss points, elastic
+/// Cosserat material), averaged over `reps` iterations after a first one that includes the
+/// symbolic analysis. Returns (free dofs, Gauss points, seconds per iteration).
+pub fn fe_iteration(n: usize, reps: usize) -> BenchResult<(usize, usize, f64)> {
+    let (mut solver, mut mat) = fe_panel(n)?;
     solver.iteration_work(&mut mat)?; // symbolic analysis
     let mut sum = IterationTiming::default();
     let reps = reps.max(1);
