@@ -9,7 +9,7 @@
 use super::linear::LinearSolver;
 use super::loading::{LoadVectors, Loading};
 use super::observer::{GaussPointState, SolutionView, StepObserver, StepReport};
-use crate::assembly::{CosseratOperator, DofMap, Field, GaussData, Pattern};
+use crate::assembly::{Assembled, CosseratOperator, DofMap, Field, GaussData, Pattern};
 use crate::element::{ElementKind, QuadratureRule};
 use crate::error::{Error, Result};
 use crate::material::{Material, MaterialError, TrialId};
@@ -370,6 +370,20 @@ impl Solver {
         }
     }
 
+    /// Residual, internal force and tangent values (into `self.values`) from the Gauss-point
+    /// responses; `du_c` is the prescribed increment of the predictor, if any.
+    fn assemble(&mut self, responses: &[MicroResponse], du_c: Option<&[f64]>) -> Assembled {
+        self.operator.assemble(
+            &self.model.mesh,
+            &self.dofs,
+            &self.gauss,
+            &self.pattern,
+            responses,
+            Some(&mut self.values),
+            du_c,
+        )
+    }
+
     /// Residual on the free dofs and the force scale of the convergence criterion.
     fn residual(&self, f_int: &[f64], f_ext: &[f64]) -> (Vec<f64>, f64) {
         let mut r = vec![0.0; self.dofs.n_free];
@@ -414,17 +428,7 @@ impl Solver {
                 Err(f) => return Ok(Attempt::Failed(f)),
             },
         };
-        let (mesh, dofs, gauss, pattern) =
-            (&self.model.mesh, &self.dofs, &self.gauss, &self.pattern);
-        let asm = self.operator.assemble(
-            mesh,
-            dofs,
-            gauss,
-            pattern,
-            &responses,
-            Some(&mut self.values),
-            Some(&du_c),
-        );
+        let asm = self.assemble(&responses, Some(&du_c));
         self.committed = Some(responses);
         let (r0, _) = self.residual(&asm.f_int, &f_ext);
         let mut rhs: Vec<f64> = r0.iter().zip(&asm.k_fc_du).map(|(r, k)| -(r + k)).collect();
@@ -454,15 +458,7 @@ impl Solver {
                     Ok(r) => r,
                     Err(f) => return Ok(Attempt::Failed(f)),
                 };
-                let asm = self.operator.assemble(
-                    &self.model.mesh,
-                    &self.dofs,
-                    &self.gauss,
-                    &self.pattern,
-                    &responses,
-                    Some(&mut self.values),
-                    None,
-                );
+                let asm = self.assemble(&responses, None);
                 let (r, scale) = self.residual(&asm.f_int, &f_ext);
                 let grows = previous.as_ref().is_some_and(|(_, rp)| norm(&r) > *rp);
                 let can_cut = self.settings.line_search
@@ -559,15 +555,7 @@ impl Solver {
         };
         let material_s = t.elapsed().as_secs_f64();
         let t = std::time::Instant::now();
-        let asm = self.operator.assemble(
-            &self.model.mesh,
-            &self.dofs,
-            &self.gauss,
-            &self.pattern,
-            &responses,
-            Some(&mut self.values),
-            None,
-        );
+        let asm = self.assemble(&responses, None);
         let f_ext = self.loads.f_ext(1.0);
         let (r, _) = self.residual(&asm.f_int, &f_ext);
         let assembly_s = t.elapsed().as_secs_f64();
