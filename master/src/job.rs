@@ -303,6 +303,9 @@ pub struct NewtonSection {
     pub line_search: bool,
     /// Smallest step as a fraction of the nominal one.
     pub min_increment_fraction: f64,
+    /// Relative force residual at which a step that ran out of iterations is accepted as
+    /// "tolerated" instead of cut (0 = never; see `SolverSettings::tolerated_residual`).
+    pub tolerated_residual: f64,
 }
 
 impl Default for NewtonSection {
@@ -314,6 +317,7 @@ impl Default for NewtonSection {
             displacement_tolerance: s.displacement_tolerance,
             line_search: s.line_search,
             min_increment_fraction: s.min_increment_fraction,
+            tolerated_residual: s.tolerated_residual,
         }
     }
 }
@@ -456,6 +460,7 @@ impl Job {
         for (name, v) in [
             ("newton.force_tolerance", n.force_tolerance),
             ("newton.displacement_tolerance", n.displacement_tolerance),
+            ("newton.tolerated_residual", n.tolerated_residual),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(bad(name, v, "must be finite and >= 0"));
@@ -576,6 +581,7 @@ impl Job {
             displacement_tolerance: n.displacement_tolerance,
             line_search: n.line_search,
             min_increment_fraction: n.min_increment_fraction,
+            tolerated_residual: n.tolerated_residual,
             ..SolverSettings::default()
         })
     }

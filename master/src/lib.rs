@@ -55,7 +55,11 @@ pub mod output;
 pub mod pool;
 /// Derived quantities for plots (equivalent strain, Eq. 34).
 pub mod post;
+/// One job run to its end into a run directory (the library side of `cosdem run`).
+pub mod run;
 /// Loading, linear solves, Newton-Raphson with step cutting, step observers.
 pub mod solve;
+/// Speed against accuracy: the knob sweep of `cosdem bench tradeoff`.
+pub mod tradeoff;
 
 pub use error::{Error, Result};

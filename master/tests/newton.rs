@@ -230,3 +230,36 @@ fn scene_b_softening_panel_runs_to_the_end() {
     assert!(log.len() >= 18);
     assert!(*load.last().unwrap() < 0.95 * peak && load[0] < 0.95 * peak, "{load:?}");
 }
+
+/// `tolerated_residual`: with one iteration allowed and a force tolerance no Newton step on
+/// the softening law reaches (1e-14), every attempt runs out of iterations. With the
+/// tolerated residual off the run ends in `StepTooSmall`; with it at 1 (any finite residual)
+/// every step is accepted at once, flagged `tolerated`, with its last residual above the
+/// force tolerance and below the tolerated one; and the accepted state is the last iterate,
+/// so the run reaches the full load.
+#[test]
+fn tolerated_residual_accepts_steps_that_ran_out_of_iterations() {
+    let strict = SolverSettings {
+        steps: 2,
+        max_iterations: 1,
+        force_tolerance: 1e-14,
+        min_increment_fraction: 0.25,
+        ..Default::default()
+    };
+    let mut mat = SofteningElastic { elastic: elastic(), beta: 400.0 };
+    let mut log: Vec<StepReport> = Vec::new();
+    let mut solver = Solver::new(panel(-0.04), strict.clone()).unwrap();
+    let err = solver.run(&mut mat, &mut log).unwrap_err();
+    assert!(matches!(err, Error::StepTooSmall { .. }), "{err}");
+
+    let tolerant = SolverSettings { tolerated_residual: 1.0, ..strict };
+    let mut log: Vec<StepReport> = Vec::new();
+    let mut solver = Solver::new(panel(-0.04), tolerant).unwrap();
+    solver.run(&mut mat, &mut log).unwrap();
+    assert_eq!(log.len(), 2);
+    for s in &log {
+        let last = *s.residuals.last().unwrap();
+        assert!(s.tolerated && s.cuts == 0 && last > 1e-14 && last <= 1.0, "{s:?}");
+    }
+    assert!((solver.load_factor() - 1.0).abs() < 1e-12);
+}

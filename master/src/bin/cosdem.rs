@@ -11,15 +11,13 @@
 
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
-use cosdem_common::GaussPointId;
-use cosdem_common::micro::{AssemblyRequest, BoundaryKind};
 use cosdem_master::bench::{Workload, fe_versus_dem, overhead, scaling, worker_binary};
-use cosdem_master::job::{Job, MaterialSection};
-use cosdem_master::material::{ElasticCosserat, Material};
-use cosdem_master::output::run_dir::{RunSettings, RunWriter};
-use cosdem_master::pool::{Pool, PoolConfig};
+use cosdem_master::job::Job;
+use cosdem_master::output::run_dir::RunWriter;
+use cosdem_master::pool::PoolConfig;
+use cosdem_master::run::{WorkerChoice, gauss_point_ids, material_for, run_settings};
 use cosdem_master::solve::{SolutionView, Solver, StepObserver, StepReport};
-use cosdem_worker::service::{Dem, Token};
+use cosdem_worker::service::Token;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -52,6 +50,54 @@ enum BenchWhat {
     Fe(FeArgs),
     /// All three with their defaults.
     All(CommonArgs),
+    /// Speed against accuracy: sweep every speed knob of a job against a tight reference
+    /// run; writes tradeoff.csv, tradeoff.md and one run directory per setting.
+    Tradeoff(TradeoffArgs),
+}
+
+#[derive(clap::Args)]
+struct TradeoffArgs {
+    /// The job whose scene is swept (a DEM job).
+    job: PathBuf,
+    /// Output directory (default: runs/tradeoff-<job stem>).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Stop every run at this displacement (m) instead of the job's (a shorter sweep).
+    #[arg(long)]
+    displacement: Option<f64>,
+}
+
+fn tradeoff(a: TradeoffArgs) -> Result<()> {
+    let mut job = Job::load(&a.job)?;
+    if let (Some(d), Some(c)) = (a.displacement, job.loading.compression.as_mut()) {
+        anyhow::ensure!(d > 0.0 && d.is_finite(), "--displacement must be > 0, got {d}");
+        c.displacement = d;
+    }
+    let stem = a.job.file_stem().map_or("job".into(), |s| s.to_string_lossy().into_owned());
+    let out = a.out.unwrap_or_else(|| Path::new("runs").join(format!("tradeoff-{stem}")));
+    std::fs::create_dir_all(&out).with_context(|| format!("creating {}", out.display()))?;
+    let title = format!("Speed against accuracy: {} ({})", job.title, a.job.display());
+    println!(
+        "{:<26} {:<14} {:>9} {:>8} {:>8} {:>8} {:>8} {:>8}",
+        "knob", "setting", "wall s", "speedup", "F_u", "F_res", "E", "curve"
+    );
+    let pct = |e: Option<f64>| e.map_or("-".into(), |e| format!("{:.2}%", 100.0 * e));
+    let rows = cosdem_master::tradeoff::sweep(&job, &title, &out, &WorkerChoice::default(), |r| {
+        println!(
+            "{:<26} {:<14} {:>9.1} {:>7.2}x {:>8} {:>8} {:>8} {:>8} {}",
+            r.knob,
+            r.setting,
+            r.wall_seconds,
+            r.speedup,
+            pct(r.errors.peak),
+            pct(r.errors.residual),
+            pct(r.errors.stiffness),
+            pct(r.errors.curve),
+            if r.status == "finished" { String::new() } else { r.status.clone() }
+        );
+    })?;
+    println!("{} settings -> {}", rows.len(), out.join("tradeoff.md").display());
+    Ok(())
 }
 
 #[derive(clap::Args, Clone)]
@@ -135,6 +181,7 @@ fn bench(what: BenchWhat) -> Result<()> {
         BenchWhat::Fe(a) => {
             fe_versus_dem(a.elements, a.discs, a.iterations, a.repeats, out).map_err(e)
         }
+        BenchWhat::Tradeoff(a) => tradeoff(a),
         BenchWhat::All(c) => {
             overhead(&workload(400, 4, 10, &c)?, out).map_err(e)?;
             scaling(&workload(400, 64, 2, &c)?, out).map_err(e)?;
@@ -219,55 +266,12 @@ fn init_logging(dir: &Path) -> Result<()> {
     Ok(())
 }
 
-/// The DEM pool: remote workers when addresses are given (CLI first, then the job), else
-/// in-process workers (no servers to start).
-fn dem_pool(
-    job: &Job,
-    args: &RunArgs,
-    spec: &cosdem_worker::AssemblySpec,
-    ids: &[GaussPointId],
-) -> Result<Pool> {
+/// Where the DEM assemblies are solved: the CLI's `--workers` first, then the job's.
+fn worker_choice(job: &Job, args: &RunArgs) -> Result<WorkerChoice> {
     let token = Token::load(args.token_file.as_deref())?;
-    let config = PoolConfig { token, ..PoolConfig::default() };
-    let addresses: Vec<String> =
+    let addresses =
         if args.workers.is_empty() { job.workers.addresses.clone() } else { args.workers.clone() };
-    // `dns:NAME:PORT` (a headless service) is the same as `NAME:PORT`: every address the name
-    // resolves to becomes a worker.
-    let addresses: Vec<String> =
-        addresses.iter().map(|a| a.strip_prefix("dns:").unwrap_or(a).to_string()).collect();
-    let mut pool = if addresses.is_empty() {
-        let n = job.workers.in_process.max(1);
-        Pool::in_process(n, config, |_| Dem)?
-    } else {
-        Pool::connect(&addresses, config)?
-    };
-    let request = AssemblyRequest {
-        spec_json: serde_json::to_vec(spec)?,
-        boundary: BoundaryKind::Unspecified,
-        disc_count_hint: 0,
-    };
-    pool.create_assemblies(ids, &request)?;
-    Ok(pool)
-}
-
-fn material(job: &Job, args: &RunArgs, ids: &[GaussPointId]) -> Result<(Box<dyn Material>, usize)> {
-    match &job.material {
-        MaterialSection::Elastic { shear_modulus, poisson, cosserat_modulus, length } => {
-            let g = *shear_modulus;
-            let m = ElasticCosserat::new(
-                g,
-                *poisson,
-                cosserat_modulus.unwrap_or(0.5 * g),
-                length.unwrap_or(0.01),
-            );
-            Ok((Box::new(m), 0))
-        }
-        MaterialSection::Dem { assembly } => {
-            let pool = dem_pool(job, args, assembly, ids)?;
-            let n = pool.live_workers();
-            Ok((Box::new(pool), n))
-        }
-    }
+    Ok(WorkerChoice { addresses, config: PoolConfig { token, ..PoolConfig::default() } })
 }
 
 fn run(args: RunArgs) -> Result<()> {
@@ -275,25 +279,10 @@ fn run(args: RunArgs) -> Result<()> {
     let dir = run_dir(&args, &job);
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     init_logging(&dir)?;
-    let internal_length = match &job.material {
-        MaterialSection::Elastic { length, .. } => length.unwrap_or(0.01),
-        MaterialSection::Dem { .. } => 0.01,
-    };
-    let settings = RunSettings {
-        title: job.title.clone(),
-        shortening: job.shortening(),
-        load_set: job.loading.load_set.clone(),
-        vtk_every: job.output.vtk_every,
-        internal_length,
-        linear_range: 0.01,
-    };
-    let mut writer = RunWriter::create(&dir, settings)?;
+    let mut writer = RunWriter::create(&dir, run_settings(&job))?;
     let mut solver = Solver::new(job.model()?, job.solver_settings()?)?;
-    let per_element = solver.gauss().per_element as u32;
-    let ids: Vec<GaussPointId> = (0..solver.model().mesh.n_elements() as u32)
-        .flat_map(|e| (0..per_element).map(move |p| GaussPointId::new(e, p)))
-        .collect();
-    let (mut material, workers) = material(&job, &args, &ids)?;
+    let ids = gauss_point_ids(&solver);
+    let (mut material, workers) = material_for(&job, &worker_choice(&job, &args)?, &ids)?;
     writer.set_workers(workers);
     let bar = if args.quiet { ProgressBar::hidden() } else { ProgressBar::new(1000) };
     bar.set_style(

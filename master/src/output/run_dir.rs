@@ -68,6 +68,9 @@ pub struct Summary {
     pub capped_relaxations: u64,
     /// Step cuts taken.
     pub cuts: u64,
+    /// Steps accepted under `newton.tolerated_residual` (ran out of iterations above the
+    /// force tolerance): their imbalance is in the log.
+    pub tolerated_steps: u64,
     /// Wall time so far (s); not deterministic.
     pub wall_seconds: f64,
     /// Workers used (set by the caller).
@@ -116,6 +119,7 @@ impl RunWriter {
             dem_steps: 0,
             capped_relaxations: 0,
             cuts: 0,
+            tolerated_steps: 0,
             wall_seconds: 0.0,
             workers: 0,
         };
@@ -221,6 +225,7 @@ impl StepObserver for RunWriter {
         self.summary.dem_steps += dem_steps;
         self.summary.capped_relaxations += capped;
         self.summary.cuts += u64::from(report.cuts);
+        self.summary.tolerated_steps += u64::from(report.tolerated);
         self.summary.metrics = CurveMetrics::from_curve(&self.curve, self.settings.linear_range);
         let row = [
             report.step as f64,

@@ -23,6 +23,10 @@ pub struct StepReport {
     pub line_search_halvings: u32,
     /// Failed attempts (step cuts) before this step converged.
     pub cuts: u32,
+    /// The step ran out of iterations and was accepted under
+    /// [`crate::solve::SolverSettings::tolerated_residual`] (its last residual is in
+    /// `residuals`), not converged to the force or displacement tolerance.
+    pub tolerated: bool,
     /// Reaction `[R_x, R_y, R_w]` (N, N, N m per metre of thickness) of every named node set:
     /// the sum of `f_int - f_ext` over the set's dofs.
     pub reactions: BTreeMap<String, [f64; 3]>,

@@ -1,0 +1,135 @@
+//! One job, run to its end into a run directory: the library side of `cosdem run`.
+//!
+//! [`material_for`] turns the job's `[material]` into what answers at the Gauss points (an
+//! analytical material, or a pool of DEM workers holding one assembly per Gauss point);
+//! [`execute`] runs the solver into a [`RunWriter`] and returns the summary. The CLI adds the
+//! progress bar, logging and signal handling on top; batch drivers (the speed/accuracy sweep,
+//! the RVE-size study) call [`run_job`] directly.
+
+use crate::job::{Job, MaterialSection};
+use crate::material::{ElasticCosserat, Material};
+use crate::output::run_dir::{RunSettings, RunWriter, Summary};
+use crate::pool::{Pool, PoolConfig};
+use crate::solve::Solver;
+use cosdem_common::GaussPointId;
+use cosdem_common::micro::{AssemblyRequest, BoundaryKind};
+use cosdem_worker::service::Dem;
+use std::path::Path;
+
+/// Errors of a whole run.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The job, the solver or the output failed.
+    #[error(transparent)]
+    Solver(#[from] crate::Error),
+    /// The worker pool could not be built or used.
+    #[error("worker pool: {0}")]
+    Pool(#[from] crate::pool::PoolError),
+    /// The run directory could not be written.
+    #[error(transparent)]
+    Output(#[from] crate::output::OutputError),
+    /// The assembly specification could not be encoded.
+    #[error("assembly spec: {0}")]
+    Spec(#[from] serde_json::Error),
+}
+
+/// Where the DEM assemblies are solved.
+#[derive(Clone, Debug, Default)]
+pub struct WorkerChoice {
+    /// Remote worker addresses (`host:port`, or a name resolving to several); empty: in-process.
+    pub addresses: Vec<String>,
+    /// Pool settings (token, deadlines, threads of in-process workers).
+    pub config: PoolConfig,
+}
+
+/// The internal length used for the equivalent strain of the job's material (m).
+pub fn internal_length(job: &Job) -> f64 {
+    match &job.material {
+        MaterialSection::Elastic { length, .. } => length.unwrap_or(0.01),
+        MaterialSection::Dem { .. } => 0.01,
+    }
+}
+
+/// The run writer's settings for a job.
+pub fn run_settings(job: &Job) -> RunSettings {
+    RunSettings {
+        title: job.title.clone(),
+        shortening: job.shortening(),
+        load_set: job.loading.load_set.clone(),
+        vtk_every: job.output.vtk_every,
+        internal_length: internal_length(job),
+        linear_range: 0.01,
+    }
+}
+
+/// Every Gauss point of the solver's mesh, element-major.
+pub fn gauss_point_ids(solver: &Solver) -> Vec<GaussPointId> {
+    let per_element = solver.gauss().per_element as u32;
+    (0..solver.model().mesh.n_elements() as u32)
+        .flat_map(|e| (0..per_element).map(move |p| GaussPointId::new(e, p)))
+        .collect()
+}
+
+/// What answers at the Gauss points, and how many workers serve it (0 for an analytical
+/// material). A DEM job gets a pool (remote workers when `workers.addresses` is non-empty,
+/// else the job's `[workers] in_process` in-process workers) with one assembly per point.
+pub fn material_for(
+    job: &Job,
+    workers: &WorkerChoice,
+    ids: &[GaussPointId],
+) -> Result<(Box<dyn Material>, usize), RunError> {
+    match &job.material {
+        MaterialSection::Elastic { shear_modulus, poisson, cosserat_modulus, length } => {
+            let g = *shear_modulus;
+            let m = ElasticCosserat::new(
+                g,
+                *poisson,
+                cosserat_modulus.unwrap_or(0.5 * g),
+                length.unwrap_or(0.01),
+            );
+            Ok((Box::new(m), 0))
+        }
+        MaterialSection::Dem { assembly } => {
+            // `dns:NAME:PORT` (a headless service) is the same as `NAME:PORT`: every address
+            // the name resolves to becomes a worker.
+            let addresses: Vec<String> = workers
+                .addresses
+                .iter()
+                .map(|a| a.strip_prefix("dns:").unwrap_or(a).to_string())
+                .collect();
+            let mut pool = if addresses.is_empty() {
+                Pool::in_process(job.workers.in_process.max(1), workers.config.clone(), |_| Dem)?
+            } else {
+                Pool::connect(&addresses, workers.config.clone())?
+            };
+            let request = AssemblyRequest {
+                spec_json: serde_json::to_vec(assembly)?,
+                boundary: BoundaryKind::Unspecified,
+                disc_count_hint: 0,
+            };
+            pool.create_assemblies(ids, &request)?;
+            let n = pool.live_workers();
+            Ok((Box::new(pool), n))
+        }
+    }
+}
+
+/// Runs `job` into `dir` (created) and returns the final summary and curve. A run that stops
+/// early (a step that cannot be cut further, a failed worker) still returns its summary, with
+/// `status = "failed: ..."` and the steps it finished: the curve so far is what the caller
+/// judges. Only errors before the first step (the job, the pool, the output directory) are
+/// returned as `Err`.
+pub fn run_job(
+    job: &Job,
+    dir: &Path,
+    workers: &WorkerChoice,
+) -> Result<(Summary, Vec<(f64, f64)>), RunError> {
+    let mut writer = RunWriter::create(dir, run_settings(job))?;
+    let mut solver = Solver::new(job.model()?, job.solver_settings()?)?;
+    let ids = gauss_point_ids(&solver);
+    let (mut material, n) = material_for(job, workers, &ids)?;
+    writer.set_workers(n);
+    let outcome = solver.run(material.as_mut(), &mut writer);
+    writer.finish(outcome.as_ref().map(|_| ()).map_err(|e| e.to_string()))?;
+    Ok((writer.summary().clone(), writer.curve().to_vec()))
+}
