@@ -15,7 +15,7 @@ use cosdem_common::GaussPointId;
 use cosdem_common::micro::{AssemblyRequest, BoundaryKind};
 use cosdem_master::bench::{Workload, fe_versus_dem, overhead, scaling, worker_binary};
 use cosdem_master::job::{Job, MaterialSection};
-use cosdem_master::material::{ElasticCosserat, Material};
+use cosdem_master::material::Material;
 use cosdem_master::output::run_dir::{RunSettings, RunWriter};
 use cosdem_master::pool::{Pool, PoolConfig};
 use cosdem_master::solve::{SolutionView, Solver, StepObserver, StepReport};
@@ -252,14 +252,8 @@ fn dem_pool(
 
 fn material(job: &Job, args: &RunArgs, ids: &[GaussPointId]) -> Result<(Box<dyn Material>, usize)> {
     match &job.material {
-        MaterialSection::Elastic { shear_modulus, poisson, cosserat_modulus, length } => {
-            let g = *shear_modulus;
-            let m = ElasticCosserat::new(
-                g,
-                *poisson,
-                cosserat_modulus.unwrap_or(0.5 * g),
-                length.unwrap_or(0.01),
-            );
+        MaterialSection::Elastic { .. } => {
+            let m = job.elastic().expect("an elastic job has an elastic material");
             Ok((Box::new(m), 0))
         }
         MaterialSection::Dem { assembly } => {
