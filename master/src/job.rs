@@ -434,7 +434,7 @@ impl Job {
             let Some(c) = &l.compression else {
                 return Err(bad("loading.increment", inc, "needs [loading.compression]"));
             };
-            if !(c.displacement / inc <= MAX_LOAD_STEPS as f64) {
+            if c.displacement / inc > MAX_LOAD_STEPS as f64 {
                 return Err(bad(
                     "loading.increment",
                     inc,

@@ -404,7 +404,7 @@ impl AssemblySpec {
             }
         }
         let n = self.packing.estimated_discs();
-        if !(n <= MAX_DISCS as f64) {
+        if n.is_nan() || n > MAX_DISCS as f64 {
             return Err(invalid(
                 "packing.side",
                 format!("{} (about {n:.3e} discs)", self.packing_side()),

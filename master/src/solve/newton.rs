@@ -95,7 +95,7 @@ impl SolverSettings {
             });
         }
         let steps = ((total / increment).abs() - 1e-9).ceil().max(1.0);
-        if !(steps <= MAX_LOAD_STEPS as f64) {
+        if steps.is_nan() || steps > MAX_LOAD_STEPS as f64 {
             return Err(Error::InvalidSetting {
                 field: "increment",
                 value: increment.to_string(),

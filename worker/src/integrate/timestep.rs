@@ -81,7 +81,7 @@ pub fn checked_step(law: &Law, m: f64, i: f64, r: f64, kf: f64, kc: f64) -> Resu
     }
     let normal = 12.0 * law.kn / m;
     let (field, top) = largest(&t);
-    if !(top <= MAX_STIFFNESS_RATIO * normal) {
+    if top > MAX_STIFFNESS_RATIO * normal {
         return Err(invalid(
             field,
             format!("{top:e} 1/s^2 against {normal:e} 1/s^2 of contact.normal.k_n = {:e}", law.kn),
