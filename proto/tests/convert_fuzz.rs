@@ -76,7 +76,7 @@ fn deformations_are_validated() {
                 }
                 Err(e) => {
                     let msg = e.to_string();
-                    let named = ["f_xx", "f_xy", "f_yx", "f_yy", "w", "k_x", "k_y", "det(F)"]
+                    let named = ["F_xx", "F_xy", "F_yx", "F_yy", "`w`", "k_x", "k_y", "det(F)"]
                         .iter()
                         .any(|f| msg.contains(f));
                     prop_assert!(named, "{msg}");
