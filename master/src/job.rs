@@ -10,8 +10,12 @@ use crate::assembly::{Component, Field};
 use crate::element::{ElementKind, QuadratureRule};
 use crate::error::{Error, Result};
 use crate::io::gmsh;
-use crate::mesh::{Mesh, MeshDescription};
-use crate::solve::{Dirichlet, EdgeLoad, EdgeLoadKind, Loading, Platens, Ramp, SolverSettings};
+use crate::material::ElasticCosserat;
+use crate::mesh::{MAX_ELEMENTS, Mesh, MeshDescription};
+use crate::solve::{
+    Dirichlet, EdgeLoad, EdgeLoadKind, Loading, MAX_LOAD_STEPS, MIN_INCREMENT_FRACTION, Platens,
+    Ramp, SolverSettings,
+};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -394,9 +398,22 @@ impl Job {
                 positive("mesh.ly", m.ly.ok_or_else(|| bad("mesh.ly", "missing", "required"))?)?;
                 for (name, n) in [("mesh.nx", m.nx), ("mesh.ny", m.ny)] {
                     match n {
-                        Some(n) if n >= 1 => {}
-                        Some(n) => return Err(bad(name, n, "must be >= 1")),
+                        Some(n) if (1..=MAX_ELEMENTS).contains(&n) => {}
+                        Some(n) => return Err(bad(name, n, "must be in [1, 1 000 000]")),
                         None => return Err(bad(name, "missing", "required for a rectangle")),
+                    }
+                }
+                let (nx, ny) = (m.nx.unwrap_or(1), m.ny.unwrap_or(1));
+                if nx.saturating_mul(ny) > MAX_ELEMENTS {
+                    return Err(bad(
+                        "mesh.nx",
+                        format!("{nx} (with mesh.ny = {ny})"),
+                        "nx * ny must be at most MAX_ELEMENTS = 1 000 000 elements",
+                    ));
+                }
+                for v in m.origin {
+                    if !v.is_finite() {
+                        return Err(bad("mesh.origin", v, "must be finite"));
                     }
                 }
                 if m.file.is_some() {
@@ -410,17 +427,24 @@ impl Job {
             }
         }
         let l = &self.loading;
-        if l.steps == 0 {
-            return Err(bad("loading.steps", 0, "must be >= 1"));
-        }
-        if let Some(inc) = l.increment {
-            positive("loading.increment", inc)?;
-            if l.compression.is_none() {
-                return Err(bad("loading.increment", inc, "needs [loading.compression]"));
-            }
+        if l.steps == 0 || l.steps > MAX_LOAD_STEPS {
+            return Err(bad("loading.steps", l.steps, "must be in [1, 1 000 000]"));
         }
         if let Some(c) = &l.compression {
             positive("loading.compression.displacement", c.displacement)?;
+        }
+        if let Some(inc) = l.increment {
+            positive("loading.increment", inc)?;
+            let Some(c) = &l.compression else {
+                return Err(bad("loading.increment", inc, "needs [loading.compression]"));
+            };
+            if c.displacement / inc > MAX_LOAD_STEPS as f64 {
+                return Err(bad(
+                    "loading.increment",
+                    inc,
+                    "too small: more than 1 000 000 load steps for the compression displacement",
+                ));
+            }
         }
         for p in &l.prescribed {
             if !p.value.is_finite() {
@@ -448,6 +472,23 @@ impl Job {
                 {
                     return Err(bad("material.length", lc, "must be finite and >= 0"));
                 }
+                // Each value may be finite and the moduli they make still overflow.
+                let m = self.elastic().expect("elastic material");
+                let d = m.tangent();
+                if !d[..4].iter().flatten().all(|v| v.is_finite()) {
+                    return Err(bad(
+                        "material.shear_modulus",
+                        shear_modulus,
+                        "with this Poisson's ratio and Cosserat modulus the elastic moduli overflow",
+                    ));
+                }
+                if !d[4][4].is_finite() {
+                    return Err(bad(
+                        "material.length",
+                        m.length,
+                        "the bending modulus 2 G lc^2 overflows",
+                    ));
+                }
             }
             MaterialSection::Dem { assembly } => assembly.validate().map_err(|e| {
                 Error::JobFile { file: "[material.assembly]".into(), message: e.to_string() }
@@ -466,14 +507,32 @@ impl Job {
                 return Err(bad(name, v, "must be finite and >= 0"));
             }
         }
-        if !(n.min_increment_fraction > 0.0 && n.min_increment_fraction <= 1.0) {
+        if !(n.min_increment_fraction >= MIN_INCREMENT_FRACTION && n.min_increment_fraction <= 1.0)
+        {
             return Err(bad(
                 "newton.min_increment_fraction",
                 n.min_increment_fraction,
-                "in (0, 1]",
+                "in [1e-12, 1]",
             ));
         }
         Ok(())
+    }
+
+    /// The linear-elastic Cosserat material of an `elastic` job (its defaults filled in:
+    /// Gc = G / 2, lc = 0.01 m); `None` for a DEM job.
+    pub fn elastic(&self) -> Option<ElasticCosserat> {
+        match &self.material {
+            MaterialSection::Elastic { shear_modulus, poisson, cosserat_modulus, length } => {
+                let g = *shear_modulus;
+                Some(ElasticCosserat::new(
+                    g,
+                    *poisson,
+                    cosserat_modulus.unwrap_or(0.5 * g),
+                    length.unwrap_or(0.01),
+                ))
+            }
+            MaterialSection::Dem { .. } => None,
+        }
     }
 
     /// The continuum field.

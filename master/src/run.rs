@@ -7,7 +7,7 @@
 //! the RVE-size study) call [`run_job`] directly.
 
 use crate::job::{Job, MaterialSection};
-use crate::material::{ElasticCosserat, Material};
+use crate::material::Material;
 use crate::output::run_dir::{RunSettings, RunWriter, Summary};
 use crate::pool::{Pool, PoolConfig};
 use crate::solve::Solver;
@@ -79,14 +79,8 @@ pub fn material_for(
     ids: &[GaussPointId],
 ) -> Result<(Box<dyn Material>, usize), RunError> {
     match &job.material {
-        MaterialSection::Elastic { shear_modulus, poisson, cosserat_modulus, length } => {
-            let g = *shear_modulus;
-            let m = ElasticCosserat::new(
-                g,
-                *poisson,
-                cosserat_modulus.unwrap_or(0.5 * g),
-                length.unwrap_or(0.01),
-            );
+        MaterialSection::Elastic { .. } => {
+            let m = job.elastic().expect("an elastic job has an elastic material");
             Ok((Box::new(m), 0))
         }
         MaterialSection::Dem { assembly } => {

@@ -99,9 +99,15 @@ pub fn build(
                 y1 = y1.max(y[k]);
             }
             // Cap the grid so a blown-up state cannot allocate without bound.
+            // A non-finite extent (a state that blew up between two divergence checks) gets
+            // one cell: the relaxation reports the divergence at its next check.
             let cap = (4.0 * (n as f64).sqrt() + 4.0).min(4096.0);
-            let cx = ((x1 - x0) / cut).floor().clamp(1.0, cap) as usize;
-            let cy = ((y1 - y0) / cut).floor().clamp(1.0, cap) as usize;
+            let cells = |extent: f64| -> usize {
+                let c = (extent / cut).floor();
+                if c.is_finite() { c.clamp(1.0, cap) as usize } else { 1 }
+            };
+            let cx = cells(x1 - x0);
+            let cy = cells(y1 - y0);
             let sx = cx as f64 / (x1 - x0).max(f64::MIN_POSITIVE);
             let sy = cy as f64 / (y1 - y0).max(f64::MIN_POSITIVE);
             let u: Vec<f64> = x.iter().map(|&xi| ((xi - x0) * sx).min(cx as f64 - 0.5)).collect();
@@ -115,6 +121,7 @@ pub fn build(
             let a2 = h[0][1].hypot(h[1][1]);
             let w1 = area / a2; // distance between the faces spanned by a2
             let w2 = area / a1;
+            // NaN casts to 0 cells: the all-pairs loop below takes over.
             let cx = ((w1 / cut).floor() as usize).min(4096);
             let cy = ((w2 / cut).floor() as usize).min(4096);
             let mut u = Vec::with_capacity(n);
@@ -237,4 +244,25 @@ pub fn build(
         }
     }
     PairList { i: pi, j: pj, ox, oy, fs, hr, xb: x.to_vec(), yb: y.to_vec(), skin }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A state that blew up between two divergence checks (NaN and infinite centres) still
+    /// builds a list (the relaxation then reports the divergence): no panic from the grid.
+    #[test]
+    fn non_finite_positions_do_not_panic() {
+        let n = 40;
+        let mut x: Vec<f64> = (0..n).map(|k| k as f64 * 0.01).collect();
+        let y = x.clone();
+        x[3] = f64::NAN;
+        x[7] = f64::INFINITY;
+        x[8] = f64::NEG_INFINITY;
+        let r = vec![0.005; n];
+        let _ = build(&x, &y, &r, 0.001, Domain::Open, &PairList::default());
+        let h = [[f64::NAN, 0.0], [0.0, 1.0]];
+        let _ = build(&x, &y, &r, 0.001, Domain::Periodic { h }, &PairList::default());
+    }
 }

@@ -27,6 +27,15 @@ pub enum Error {
         /// Steps taken when the blow-up was detected.
         steps: u64,
     },
+    /// The relaxed state is finite but its homogenized answer is not (e.g. a target whose
+    /// det(F) underflows the current area to zero).
+    #[error("non-finite homogenized {what} at det(F) = {det:e}")]
+    NonFinite {
+        /// `stress` or `tangent`.
+        what: &'static str,
+        /// det(Fbar) of the target.
+        det: f64,
+    },
     /// A serialized assembly could not be decoded.
     #[error("cannot decode assembly state: {0}")]
     Decode(String),

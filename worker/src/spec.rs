@@ -316,6 +316,37 @@ pub enum TangentKind {
     },
 }
 
+/// Most discs one assembly may hold (a cap so that a typo in `side` or `radius`, or a hostile
+/// request, cannot ask a worker for 10^17 discs). The paper's largest assemblies hold a few
+/// thousand; 10^6 discs take about 0.5 GB.
+pub const MAX_DISCS: usize = 1_000_000;
+
+/// Most steps one relaxation may be given (`relaxation.max_steps`): at the measured 2-3e7
+/// particle-steps per second, 10^8 steps of even 100 discs are several minutes for one Gauss
+/// point of one Newton iteration, which is a hang, not a solve.
+pub const MAX_RELAXATION_STEPS: u64 = 100_000_000;
+
+impl PackingSpec {
+    /// The number of discs this packing will hold, estimated before anything is allocated
+    /// (exact for an explicit radius list; within a few per cent otherwise). May be infinite
+    /// for absurd ratios of side to radius.
+    pub fn estimated_discs(&self) -> f64 {
+        match self {
+            PackingSpec::Hexagonal { radius, side } => {
+                (side / (2.0 * radius) + 1.0) * (side / (3f64.sqrt() * radius) + 1.0)
+            }
+            PackingSpec::Random { r_min, r_max, radii, side, .. } => {
+                if radii.is_empty() {
+                    let er2 = (r_min * r_min + r_min * r_max + r_max * r_max) / 3.0;
+                    0.84 * side * side / (std::f64::consts::PI * er2)
+                } else {
+                    radii.len() as f64
+                }
+            }
+        }
+    }
+}
+
 impl AssemblySpec {
     /// Checks every field; errors name the field and value.
     pub fn validate(&self) -> Result<()> {
@@ -363,7 +394,22 @@ impl AssemblySpec {
                         "must be at least four largest diameters (8 r_max)",
                     ));
                 }
+                if radii.len() > MAX_DISCS {
+                    return Err(invalid(
+                        "packing.radii",
+                        format!("{} radii", radii.len()),
+                        "more than MAX_DISCS = 1 000 000 discs in one assembly",
+                    ));
+                }
             }
+        }
+        let n = self.packing.estimated_discs();
+        if n.is_nan() || n > MAX_DISCS as f64 {
+            return Err(invalid(
+                "packing.side",
+                format!("{} (about {n:.3e} discs)", self.packing_side()),
+                "side / radius too large: more than MAX_DISCS = 1 000 000 discs in one assembly",
+            ));
         }
         match &self.contact.normal {
             NormalModel::Linear { k_n } => positive("contact.normal.k_n", *k_n)?,
@@ -389,8 +435,12 @@ impl AssemblySpec {
         }
         let r = &self.relaxation;
         positive("relaxation.tolerance", r.tolerance)?;
-        if r.max_steps == 0 {
-            return Err(invalid("relaxation.max_steps", 0, "must be >= 1"));
+        if r.max_steps == 0 || r.max_steps > MAX_RELAXATION_STEPS {
+            return Err(invalid(
+                "relaxation.max_steps",
+                r.max_steps,
+                "must be in [1, 100 000 000] (MAX_RELAXATION_STEPS)",
+            ));
         }
         if r.check_every == 0 {
             return Err(invalid("relaxation.check_every", 0, "must be >= 1"));
@@ -440,5 +490,11 @@ impl AssemblySpec {
             positive("tangent.strain", *strain)?;
         }
         Ok(())
+    }
+
+    fn packing_side(&self) -> f64 {
+        match &self.packing {
+            PackingSpec::Hexagonal { side, .. } | PackingSpec::Random { side, .. } => *side,
+        }
     }
 }

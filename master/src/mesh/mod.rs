@@ -4,6 +4,7 @@
 //! Gmsh reader only has to fill a [`MeshDescription`].
 
 mod structured;
+pub use structured::MAX_ELEMENTS;
 
 use crate::element::ElementKind;
 use crate::error::{Error, Result};

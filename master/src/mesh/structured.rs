@@ -4,6 +4,11 @@ use super::{Mesh, MeshDescription};
 use crate::element::ElementKind;
 use crate::error::{Error, Result};
 
+/// Most elements of a structured rectangle: a cap so that a typo (or a hostile job file)
+/// cannot ask for 10^18 elements. The paper's largest mesh has 100; a million Q8 elements
+/// with one DEM assembly per Gauss point is far beyond any machine this runs on.
+pub const MAX_ELEMENTS: usize = 1_000_000;
+
 impl Mesh {
     /// A `lx` x `ly` rectangle with lower-left corner `origin`, split into `nx` x `ny`
     /// elements of `kind`.
@@ -19,12 +24,12 @@ impl Mesh {
         ny: usize,
         origin: [f64; 2],
     ) -> Result<Self> {
-        for (field, v) in [("lx", lx), ("ly", ly)] {
-            if !(v > 0.0 && v.is_finite()) {
+        for (field, v) in [("lx", lx), ("ly", ly), ("origin", origin[0]), ("origin", origin[1])] {
+            if !(v.is_finite() && (v > 0.0 || field == "origin")) {
                 return Err(Error::InvalidMesh {
                     field,
                     value: v.to_string(),
-                    reason: "must be > 0".into(),
+                    reason: "must be finite (and > 0 for lx, ly)".into(),
                 });
             }
         }
@@ -36,6 +41,13 @@ impl Mesh {
                     reason: "must be >= 1".into(),
                 });
             }
+        }
+        if nx.checked_mul(ny).is_none_or(|n| n > MAX_ELEMENTS) {
+            return Err(Error::InvalidMesh {
+                field: "nx * ny",
+                value: format!("{nx} * {ny}"),
+                reason: format!("more than MAX_ELEMENTS = {MAX_ELEMENTS} elements"),
+            });
         }
         let (gx, gy) = (2 * nx + 1, 2 * ny + 1);
         let skip = |i: usize, j: usize| kind == ElementKind::Q8 && i % 2 == 1 && j % 2 == 1;

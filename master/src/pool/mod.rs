@@ -521,7 +521,18 @@ impl Pool {
     /// other workers when an import target fails.
     async fn restore(&mut self, ids: &[GaussPointId]) -> Result<(), MaterialError> {
         let mut todo: Vec<GaussPointId> = ids.to_vec();
+        // Ends: every pass that leaves work marks at least one worker dead, and no worker
+        // returns inside this loop (re-admission happens at step boundaries).
+        let mut rounds = 0usize;
         while !todo.is_empty() {
+            rounds += 1;
+            if rounds > self.workers.len() + 1 {
+                return Err(MaterialError::Unavailable(format!(
+                    "restore of {} assemblies still failing after {} rounds of worker losses",
+                    todo.len(),
+                    rounds - 1
+                )));
+            }
             let alive = self.alive();
             if alive.is_empty() {
                 return Err(MaterialError::Unavailable("every worker is lost".into()));
@@ -587,7 +598,17 @@ impl Pool {
         let mut pending: Vec<GaussPointId> = targets.keys().copied().collect();
         let mut out = Outcomes::new();
         let mut first = true;
+        // Ends: a pass that leaves work lost at least one worker (see `restore`).
+        let mut rounds = 0usize;
         while !pending.is_empty() {
+            rounds += 1;
+            if rounds > self.workers.len() + 1 {
+                return Err(MaterialError::Unavailable(format!(
+                    "solve of {} gauss points still failing after {} rounds of worker losses",
+                    pending.len(),
+                    rounds - 1
+                )));
+            }
             if !first {
                 self.stats.resolved += pending.len() as u64;
             }
@@ -699,7 +720,16 @@ impl Pool {
             )));
         }
         let mut pending: Vec<GaussPointId> = targets.keys().copied().collect();
+        // Ends: a pass that leaves work lost at least one worker (see `restore`).
+        let mut rounds = 0usize;
         while !pending.is_empty() {
+            rounds += 1;
+            if rounds > self.workers.len() + 1 {
+                return Err(MaterialError::Unavailable(format!(
+                    "commit of step {step} still failing after {} rounds of worker losses",
+                    rounds - 1
+                )));
+            }
             let mut by_worker: BTreeMap<usize, Vec<GaussPointId>> = BTreeMap::new();
             for id in &pending {
                 by_worker.entry(self.owner[id]).or_default().push(*id);

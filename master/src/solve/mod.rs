@@ -10,5 +10,8 @@ pub use linear::LinearSolver;
 pub use loading::{
     BodyLoad, Dirichlet, EdgeLoad, EdgeLoadKind, LoadVectors, Loading, Platens, Ramp,
 };
-pub use newton::{IterationTiming, Model, RunSummary, Solver, SolverSettings};
+pub use newton::{
+    IterationTiming, MAX_LOAD_STEPS, MIN_INCREMENT_FRACTION, Model, RunSummary, Solver,
+    SolverSettings,
+};
 pub use observer::{GaussPointState, SolutionView, StepObserver, StepReport};

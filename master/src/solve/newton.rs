@@ -30,6 +30,15 @@ pub struct Model {
     pub loading: Loading,
 }
 
+/// Most nominal load steps of a run: a cap so that a tiny `increment` cannot ask for 10^300
+/// steps (a hang). The paper's runs use tens to hundreds.
+pub const MAX_LOAD_STEPS: usize = 1_000_000;
+
+/// Smallest allowed `min_increment_fraction`: with at most [`MAX_LOAD_STEPS`] steps the
+/// smallest increment stays above 1e-18, which the load factor (at most 1) can still resolve
+/// to within a factor of 10, so a step cut to the minimum still moves the load.
+pub const MIN_INCREMENT_FRACTION: f64 = 1e-12;
+
 /// Newton-Raphson and step-control parameters.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct SolverSettings {
@@ -94,15 +103,26 @@ impl SolverSettings {
                 reason: "must be finite and non-zero".into(),
             });
         }
-        Ok(((total / increment).abs() - 1e-9).ceil().max(1.0) as usize)
+        let steps = ((total / increment).abs() - 1e-9).ceil().max(1.0);
+        if steps.is_nan() || steps > MAX_LOAD_STEPS as f64 {
+            return Err(Error::InvalidSetting {
+                field: "increment",
+                value: increment.to_string(),
+                reason: format!(
+                    "gives {steps:e} load steps for a total of {total}: more than MAX_LOAD_STEPS = \
+                     {MAX_LOAD_STEPS}"
+                ),
+            });
+        }
+        Ok(steps as usize)
     }
 
     fn check(&self) -> Result<()> {
         let bad = |field: &'static str, value: String, reason: &str| {
             Err(Error::InvalidSetting { field, value, reason: reason.into() })
         };
-        if self.steps == 0 {
-            return bad("steps", "0".into(), "must be >= 1");
+        if self.steps == 0 || self.steps > MAX_LOAD_STEPS {
+            return bad("steps", self.steps.to_string(), "must be in [1, MAX_LOAD_STEPS = 10^6]");
         }
         if self.max_iterations == 0 {
             return bad("max_iterations", "0".into(), "must be >= 1");
@@ -110,11 +130,13 @@ impl SolverSettings {
         if !(self.force_tolerance >= 0.0 && self.displacement_tolerance >= 0.0) {
             return bad("tolerances", format!("{self:?}"), "must be >= 0");
         }
-        if !(self.min_increment_fraction > 0.0 && self.min_increment_fraction <= 1.0) {
+        if !(self.min_increment_fraction >= MIN_INCREMENT_FRACTION
+            && self.min_increment_fraction <= 1.0)
+        {
             return bad(
                 "min_increment_fraction",
                 self.min_increment_fraction.to_string(),
-                "in (0, 1]",
+                "in [1e-12, 1]",
             );
         }
         if !(self.tolerated_residual.is_finite() && self.tolerated_residual >= 0.0) {
@@ -300,9 +322,23 @@ impl Solver {
         let mut summary = RunSummary::default();
         let mut cuts = 0u32;
         let mut iteration = 0u32; // TrialId.iteration: keeps counting across cuts
+        // Ends: every pass either converges (the load factor grows by at least the minimum
+        // increment, checked below) or cuts the increment, and at most log2(1 /
+        // min_increment_fraction) + 1 cuts in a row end the run with StepTooSmall.
         while self.lambda < 1.0 - 1e-12 {
             let target = (self.lambda + increment).min(1.0);
             let step = self.step + 1;
+            if target <= self.lambda {
+                return Err(Error::InvalidSetting {
+                    field: "min_increment_fraction",
+                    value: self.settings.min_increment_fraction.to_string(),
+                    reason: format!(
+                        "the increment {increment:e} no longer moves the load factor \
+                         {:.17}: raise it",
+                        self.lambda
+                    ),
+                });
+            }
             let span = tracing::info_span!("load_step", step, lambda = target);
             let _enter = span.enter();
             match self.attempt(material, step, &mut iteration, target)? {

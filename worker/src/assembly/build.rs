@@ -3,7 +3,7 @@ use crate::boundary::penalty::boundary_layer;
 use crate::broadphase::{self, PairList};
 use crate::contact::Law;
 use crate::error::{Error, Result};
-use crate::integrate::{self, Dynamics, Work, timestep::critical_step};
+use crate::integrate::{self, Dynamics, Work, timestep::checked_step};
 use crate::packing::{Packing, hexagonal, random};
 use crate::spec::{AssemblySpec, BoundarySpec, PackingSpec, RollingModel, TangentialModel};
 use cosdem_common::MacroDeformation;
@@ -17,14 +17,15 @@ pub(super) fn new(spec: &AssemblySpec) -> Result<Assembly> {
                 BoundarySpec::Penalty { .. } => hexagonal::square(*radius, *side),
                 BoundarySpec::Periodic => hexagonal::periodic(*radius, *side),
             };
-            Ok(from_packing(spec, law, p))
+            from_packing(spec, law, p)
         }
         PackingSpec::Random { .. } => random_assembly(spec, law),
     }
 }
 
 /// An assembly at rest in the reference state of `p` (no histories, identity target).
-pub(super) fn from_packing(spec: &AssemblySpec, law: Law, p: Packing) -> Assembly {
+/// Fails, naming the parameter, when the explicit time step is unusable.
+pub(super) fn from_packing(spec: &AssemblySpec, law: Law, p: Packing) -> Result<Assembly> {
     let n = p.r.len();
     let rho = spec.density * spec.relaxation.density_scale;
     let mut inv_m = Vec::with_capacity(n);
@@ -45,7 +46,7 @@ pub(super) fn from_packing(spec: &AssemblySpec, law: Law, p: Packing) -> Assembl
     };
     let m_min = rho * std::f64::consts::PI * r_min * r_min;
     let dt = spec.relaxation.safety
-        * critical_step(&law, m_min, 0.5 * m_min * r_min * r_min, r_min, kf, kc);
+        * checked_step(&law, m_min, 0.5 * m_min * r_min * r_min, r_min, kf, kc)?;
     let refc = Reference {
         r: p.r.clone(),
         inv_m,
@@ -79,7 +80,7 @@ pub(super) fn from_packing(spec: &AssemblySpec, law: Law, p: Packing) -> Assembl
     let skin = spec.relaxation.skin * r_min;
     let d = &a.committed.dynamics;
     a.committed.pairs = broadphase::build(&d.x, &d.y, &a.refc.r, skin, dom, &PairList::default());
-    a
+    Ok(a)
 }
 
 /// Random packing (see [`crate::packing::random`]): periodic frictionless compression to the
@@ -101,7 +102,7 @@ fn random_assembly(spec: &AssemblySpec, law: Law) -> Result<Assembly> {
     s1.relaxation.max_steps = 4_000;
     // FIRE relaxes the frictionless compression stages several times faster than Cundall.
     s1.relaxation.driver = crate::spec::Driver::fire();
-    let mut a = from_packing(&s1, Law::from_params(&s1.contact), loose);
+    let mut a = from_packing(&s1, Law::from_params(&s1.contact), loose)?;
     let pressure = |s: &[f64; 6]| -0.5 * (s[0] + s[1]);
     let target = *confining_stress;
     let iso = |l: f64| MacroDeformation { f: [[l, 0.0], [0.0, l]], w: 0.0, kappa: [0.0; 2] };
@@ -175,7 +176,7 @@ fn random_assembly(spec: &AssemblySpec, law: Law) -> Result<Assembly> {
         }
     }
     let _ = l;
-    let mut b = from_packing(spec, law, p);
+    let mut b = from_packing(spec, law, p)?;
     if let BoundarySpec::Penalty { eps_f, eps_c } = spec.boundary {
         prestress_reference(&mut b, eps_f, eps_c);
     }
@@ -199,7 +200,7 @@ fn random_assembly(spec: &AssemblySpec, law: Law) -> Result<Assembly> {
         r = b.solve(&iso(1.0 + e))?;
     }
     if e != 0.0 {
-        b = rereference(&b, spec, law, 1.0 + e);
+        b = rereference(&b, spec, law, 1.0 + e)?;
     }
     // Final relaxation at the reference with the full contact law.
     let resp = b.solve(&MacroDeformation::IDENTITY)?;
@@ -216,7 +217,7 @@ fn random_assembly(spec: &AssemblySpec, law: Law) -> Result<Assembly> {
 /// The trial state of `b` (relaxed at `Fbar = lam I`) as a new reference: region scaled by
 /// `lam` about its centre, contact histories kept, penalty rest points placed by
 /// [`prestress_reference`].
-fn rereference(b: &Assembly, spec: &AssemblySpec, law: Law, lam: f64) -> Assembly {
+fn rereference(b: &Assembly, spec: &AssemblySpec, law: Law, lam: f64) -> Result<Assembly> {
     let st = b.trial.as_ref().unwrap_or(&b.committed);
     let (lx, ly) = (lam * b.refc.lx, lam * b.refc.ly);
     let sx = b.refc.xc[0] - 0.5 * lx;
@@ -229,7 +230,7 @@ fn rereference(b: &Assembly, spec: &AssemblySpec, law: Law, lam: f64) -> Assembl
         lx,
         ly,
     };
-    let mut c = from_packing(spec, law, p);
+    let mut c = from_packing(spec, law, p)?;
     let skin = spec.relaxation.skin * c.refc.r_min;
     let cd = &c.committed.dynamics;
     let dom = c.domain(&MacroDeformation::IDENTITY);
@@ -237,7 +238,7 @@ fn rereference(b: &Assembly, spec: &AssemblySpec, law: Law, lam: f64) -> Assembl
     if let BoundarySpec::Penalty { eps_f, eps_c } = spec.boundary {
         prestress_reference(&mut c, eps_f, eps_c);
     }
-    c
+    Ok(c)
 }
 
 /// Moves the rest points of the boundary particles' penalty springs so that, at Fbar = I, each

@@ -94,6 +94,9 @@ impl Assembly {
         if len + used != rest.len() {
             return Err(Error::Decode(format!("{} trailing bytes", rest.len() - len - used)));
         }
+        if !(body.dt.is_finite() && body.dt > 0.0) {
+            return Err(Error::Decode(format!("time step {} is not positive and finite", body.dt)));
+        }
         let n = body.refc.r.len();
         let ok = |st: &super::State| {
             let d = &st.dynamics;

@@ -2,7 +2,7 @@ use super::{Assembly, State};
 use crate::boundary::{mat_inv, mat_mul, rotation_angle};
 use crate::broadphase;
 use crate::contact::rolling;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::homogenize::{Homogenized, homogenize};
 use crate::integrate::{self, RelaxReport};
 use crate::spec::{BoundarySpec, TangentKind};
@@ -37,6 +37,14 @@ impl Assembly {
             rolling_fraction: h.fabric.rolling_fraction,
             wall_seconds: t0.elapsed().as_secs_f64(),
         };
+        // Never NaN on the wire: a non-finite answer is an error of this Gauss point.
+        let det = st.target.det();
+        if !h.stress.iter().all(|v| v.is_finite()) {
+            return Err(Error::NonFinite { what: "stress", det });
+        }
+        if !tangent.iter().flatten().all(|v| v.is_finite()) {
+            return Err(Error::NonFinite { what: "tangent", det });
+        }
         self.trial = Some(st);
         Ok(MicroResponse { stress: h.stress, tangent, diagnostics })
     }

@@ -61,7 +61,8 @@ impl<M: MicroModel> Registry<M> {
     /// (assemblies, discs, relaxations in flight).
     pub fn load(&self) -> (u64, u64, u64) {
         let e = lock(&self.entries);
-        (e.len() as u64, e.values().map(|x| x.discs).sum(), self.in_flight.load(Ordering::SeqCst))
+        let discs = e.values().fold(0u64, |a, x| a.saturating_add(x.discs));
+        (e.len() as u64, discs, self.in_flight.load(Ordering::SeqCst))
     }
 
     fn check_limits(
@@ -70,16 +71,23 @@ impl<M: MicroModel> Registry<M> {
         new: &[(GaussPointId, u64)],
     ) -> Result<()> {
         let added: Vec<_> = new.iter().filter(|(id, _)| !entries.contains_key(id)).collect();
-        let count = entries.len() as u64 + added.len() as u64;
+        // Saturating: a hostile disc-count hint (u64::MAX) must give RESOURCE_EXHAUSTED, not
+        // an overflow.
+        let count = (entries.len() as u64).saturating_add(added.len() as u64);
         if self.limits.max_assemblies > 0 && count > self.limits.max_assemblies {
             return Err(ServiceError::ResourceExhausted(format!(
                 "{count} assemblies would exceed this worker's limit of {}",
                 self.limits.max_assemblies
             )));
         }
-        let replaced: u64 = new.iter().filter_map(|(id, _)| entries.get(id).map(|e| e.discs)).sum();
-        let discs = entries.values().map(|e| e.discs).sum::<u64>() - replaced
-            + new.iter().map(|(_, d)| d).sum::<u64>();
+        let replaced = new
+            .iter()
+            .filter_map(|(id, _)| entries.get(id).map(|e| e.discs))
+            .fold(0u64, u64::saturating_add);
+        let held = entries.values().fold(0u64, |a, e| a.saturating_add(e.discs));
+        let discs = held
+            .saturating_sub(replaced)
+            .saturating_add(new.iter().fold(0u64, |a, (_, d)| a.saturating_add(*d)));
         if self.limits.max_discs > 0 && discs > self.limits.max_discs {
             return Err(ServiceError::ResourceExhausted(format!(
                 "{discs} discs would exceed this worker's limit of {}",
