@@ -71,6 +71,7 @@ pub(super) fn from_packing(spec: &AssemblySpec, law: Law, p: Packing) -> Assembl
             dynamics,
             pairs: PairList::default(),
             target: MacroDeformation::IDENTITY,
+            relaxed: None,
         },
         trial: None,
         work: Work::default(),
