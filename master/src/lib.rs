@@ -57,5 +57,7 @@ pub mod pool;
 pub mod post;
 /// Loading, linear solves, Newton-Raphson with step cutting, step observers.
 pub mod solve;
+/// Symmetric scenes on a half or quarter mesh: the reduced rectangle and its axis conditions.
+pub mod symmetry;
 
 pub use error::{Error, Result};

@@ -283,6 +283,7 @@ fn run(args: RunArgs) -> Result<()> {
         title: job.title.clone(),
         shortening: job.shortening(),
         load_set: job.loading.load_set.clone(),
+        load_scale: job.load_scale(),
         vtk_every: job.output.vtk_every,
         internal_length,
         linear_range: 0.01,
@@ -323,6 +324,12 @@ fn run(args: RunArgs) -> Result<()> {
         s.wall_seconds,
         dir.display()
     );
+    if s.skipped_relaxations + s.linear_answers > 0 {
+        println!(
+            "answers without relaxation: {} skipped, {} linear (largest stress-error bound {:.3e} Pa)",
+            s.skipped_relaxations, s.linear_answers, s.max_error_bound
+        );
+    }
     outcome.with_context(|| format!("run stopped; finished steps are in {}", dir.display()))?;
     Ok(())
 }

@@ -30,7 +30,9 @@ use crate::boundary::{mat_inv, mat_mul, rotation_angle};
 use crate::contact::rolling;
 use crate::spec::BoundarySpec;
 use cosdem_common::voigt::N;
-use cosdem_common::{Answer, MacroDeformation, MicroDiagnostics, MicroResponse, StressVector, Tangent};
+use cosdem_common::{
+    Answer, MacroDeformation, MicroDiagnostics, MicroResponse, StressVector, Tangent,
+};
 use serde::{Deserialize, Serialize};
 
 /// Margin of the elastic-shortcut check: a contact must stay 10 % inside its Coulomb and
@@ -171,12 +173,7 @@ impl Assembly {
 }
 
 /// `s_0 + C (e - e_0)` with tangent `C` from the relaxed state `st` (which has an answer).
-fn extrapolate(
-    st: &State,
-    target: &MacroDeformation,
-    answer: Answer,
-    size: f64,
-) -> MicroResponse {
+fn extrapolate(st: &State, target: &MacroDeformation, answer: Answer, size: f64) -> MicroResponse {
     let rel = st.relaxed.as_ref().expect("checked by the caller");
     let (e0, e1) = (st.target.strain(), target.strain());
     let mut stress = rel.stress;
