@@ -26,6 +26,48 @@ pub struct MicroDiagnostics {
     pub rolling_fraction: f64,
     /// Wall time of the solve in seconds (not part of any deterministic result).
     pub wall_seconds: f64,
+    /// How the answer was obtained: a relaxation, or a shortcut from the last relaxed state.
+    pub answer: Answer,
+    /// Size of the deformation increment answered without a relaxation (the skip measure
+    /// `max(|dF_ij|, |dw|, l |dk_i|)` since the last relaxation; 0 when relaxed).
+    pub unrelaxed_increment: f64,
+    /// Estimated bound on the stress error the shortcut adds: the largest component of the
+    /// extrapolated stress increment `|C de|` (Pa, or N for couple stresses), 0 when relaxed.
+    pub error_bound: f64,
+}
+
+/// How a material point produced its answer.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Answer {
+    /// A relaxation to the requested deformation (or an analytical material).
+    #[default]
+    Relaxed,
+    /// Not relaxed: the increment since the last relaxation was below `relaxation.skip_below`;
+    /// the last relaxed stress plus tangent times the strain increment answered.
+    Skipped,
+    /// Not relaxed: the increment keeps every contact sticking and none opens or closes
+    /// (`relaxation.elastic_shortcut`); answered through the tangent as for `Skipped`.
+    Linear,
+}
+
+impl Answer {
+    /// Wire code (0 relaxed, 1 skipped, 2 linear).
+    pub fn code(self) -> u32 {
+        match self {
+            Answer::Relaxed => 0,
+            Answer::Skipped => 1,
+            Answer::Linear => 2,
+        }
+    }
+
+    /// From the wire code; unknown codes read as `Relaxed`.
+    pub fn from_code(c: u32) -> Self {
+        match c {
+            1 => Answer::Skipped,
+            2 => Answer::Linear,
+            _ => Answer::Relaxed,
+        }
+    }
 }
 
 /// Homogenized response of one Gauss point for one trial deformation.

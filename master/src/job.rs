@@ -16,6 +16,7 @@ use crate::solve::{
     Dirichlet, EdgeLoad, EdgeLoadKind, Loading, MAX_LOAD_STEPS, MIN_INCREMENT_FRACTION, Platens,
     Ramp, SolverSettings,
 };
+use crate::symmetry::Symmetry;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -112,6 +113,10 @@ pub struct MeshSection {
     pub continuum: Continuum,
     /// The `.msh` file, gmsh only; relative to the job file.
     pub file: Option<PathBuf>,
+    /// `none` (default), `half_x` or `quarter`: mesh only the left half or lower-left quarter
+    /// of a symmetric rectangle (see [`crate::symmetry`]).
+    #[serde(default)]
+    pub symmetry: Symmetry,
 }
 
 fn default_element() -> ElementChoice {
@@ -419,8 +424,31 @@ impl Job {
                 if m.file.is_some() {
                     return Err(bad("mesh.file", "given", "only for kind = \"gmsh\""));
                 }
+                let even = |name: &'static str, n: Option<usize>| match n {
+                    Some(n) if n % 2 == 1 => {
+                        Err(bad(name, n, "must be even to cut the mesh on its mid-line"))
+                    }
+                    _ => Ok(()),
+                };
+                if m.symmetry != Symmetry::None {
+                    even("mesh.nx", m.nx)?;
+                }
+                if m.symmetry == Symmetry::Quarter {
+                    even("mesh.ny", m.ny)?;
+                    let both = self.loading.compression.as_ref().map(|c| c.moving);
+                    if both != Some(Moving::Both) {
+                        return Err(bad(
+                            "mesh.symmetry",
+                            "quarter",
+                            "needs [loading.compression] with moving = \"both\" (symmetric about the horizontal mid-line)",
+                        ));
+                    }
+                }
             }
             MeshKind::Gmsh => {
+                if m.symmetry != Symmetry::None {
+                    return Err(bad("mesh.symmetry", "given", "only for kind = \"rectangle\""));
+                }
                 if m.file.is_none() {
                     return Err(bad("mesh.file", "missing", "required for kind = \"gmsh\""));
                 }
@@ -553,8 +581,13 @@ impl Job {
                     ElementChoice::Q9 => ElementKind::Q9,
                 };
                 // validate() made sure these are present.
-                let (lx, ly) = (m.lx.unwrap_or(1.0), m.ly.unwrap_or(1.0));
-                Mesh::rectangle(kind, lx, ly, m.nx.unwrap_or(1), m.ny.unwrap_or(1), m.origin)
+                let (lx, ly, nx, ny) = m.symmetry.reduce_rectangle(
+                    m.lx.unwrap_or(1.0),
+                    m.ly.unwrap_or(1.0),
+                    m.nx.unwrap_or(1),
+                    m.ny.unwrap_or(1),
+                );
+                Mesh::rectangle(kind, lx, ly, nx, ny, m.origin)
             }
             MeshKind::Gmsh => {
                 let file = m.file.as_deref().unwrap_or(Path::new(""));
@@ -598,7 +631,13 @@ impl Job {
                 ramp,
             });
         }
-        loading
+        self.mesh.symmetry.reduce_loading(loading, self.field())
+    }
+
+    /// Factor from the meshed part's reaction to the whole panel's load (2 on a half or
+    /// quarter mesh).
+    pub fn load_scale(&self) -> f64 {
+        self.mesh.symmetry.load_scale()
     }
 
     /// Total shortening of the compression (m), 0 without one: the curve's abscissa is

@@ -59,6 +59,8 @@ pub mod post;
 pub mod run;
 /// Loading, linear solves, Newton-Raphson with step cutting, step observers.
 pub mod solve;
+/// Symmetric scenes on a half or quarter mesh: the reduced rectangle and its axis conditions.
+pub mod symmetry;
 /// Speed against accuracy: the knob sweep of `cosdem bench tradeoff`.
 pub mod tradeoff;
 

@@ -56,6 +56,7 @@ pub fn run_settings(job: &Job) -> RunSettings {
         title: job.title.clone(),
         shortening: job.shortening(),
         load_set: job.loading.load_set.clone(),
+        load_scale: job.load_scale(),
         vtk_every: job.output.vtk_every,
         internal_length: internal_length(job),
         linear_range: 0.01,

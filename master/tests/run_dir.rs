@@ -36,6 +36,7 @@ fn every_step_is_on_disk_with_its_metrics() {
         title: job.title.clone(),
         shortening: job.shortening(),
         load_set: job.loading.load_set.clone(),
+        load_scale: job.load_scale(),
         vtk_every: 1,
         internal_length: 0.01,
         linear_range: 0.01,

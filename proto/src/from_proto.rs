@@ -73,6 +73,9 @@ impl From<pb::MicroDiagnostics> for MicroDiagnostics {
             sliding_fraction: d.sliding_fraction,
             rolling_fraction: d.rolling_fraction,
             wall_seconds: d.wall_seconds,
+            answer: cosdem_common::Answer::from_code(d.answer),
+            unrelaxed_increment: d.unrelaxed_increment,
+            error_bound: d.error_bound,
         }
     }
 }

@@ -36,6 +36,9 @@ impl From<&MicroDiagnostics> for pb::MicroDiagnostics {
             sliding_fraction: d.sliding_fraction,
             rolling_fraction: d.rolling_fraction,
             wall_seconds: d.wall_seconds,
+            answer: d.answer.code(),
+            unrelaxed_increment: d.unrelaxed_increment,
+            error_bound: d.error_bound,
         }
     }
 }

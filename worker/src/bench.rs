@@ -3,7 +3,7 @@
 
 use crate::assembly::Assembly;
 use crate::error::Result;
-use crate::spec::{AssemblySpec, PackingSpec};
+use crate::spec::{AssemblySpec, ContactParams, PackingSpec};
 use cosdem_common::MacroDeformation;
 use std::time::Instant;
 
@@ -20,10 +20,18 @@ pub struct Rate {
 
 /// Hexagonal assembly of radius 5 mm with about `n` discs, default contact law.
 pub fn hexagonal(n: usize) -> Result<Assembly> {
+    hexagonal_with(n, ContactParams::default())
+}
+
+/// Hexagonal assembly of radius 5 mm with about `n` discs and the given contact law.
+pub fn hexagonal_with(n: usize, contact: ContactParams) -> Result<Assembly> {
     let r = 0.005;
     let side = (n as f64 * 2.0 * 3f64.sqrt() * r * r).sqrt() + 2.0 * r;
-    let spec =
-        AssemblySpec { packing: PackingSpec::Hexagonal { radius: r, side }, ..Default::default() };
+    let spec = AssemblySpec {
+        packing: PackingSpec::Hexagonal { radius: r, side },
+        contact,
+        ..Default::default()
+    };
     Assembly::new(&spec)
 }
 
@@ -31,7 +39,12 @@ pub fn hexagonal(n: usize) -> Result<Assembly> {
 /// chunk: affine jump of the boundary targets, 100 damped steps, commit), `steps` steps in
 /// all, full contact law, one core. Returns the rate in particle-steps per second.
 pub fn rate(n: usize, steps: u64) -> Result<Rate> {
-    let mut a = hexagonal(n)?;
+    rate_with(n, steps, ContactParams::default())
+}
+
+/// As [`rate`] with the given contact law (what switching a sub-model off saves).
+pub fn rate_with(n: usize, steps: u64, contact: ContactParams) -> Result<Rate> {
+    let mut a = hexagonal_with(n, contact)?;
     let chunk = 500u64;
     let mut e = 0.0;
     let mut run = |a: &mut Assembly, count: u64| -> Result<u64> {

@@ -64,6 +64,39 @@ fn bench_dem(quick: bool) -> Result<()> {
         let r = cosdem_worker::bench::rate(n, steps)?;
         println!("{:>6} discs {:>8} steps {:.3e} particle-steps/s", r.discs, r.steps, r.rate);
     }
+    // What a switched-off sub-model saves (issue 6, item 3b): the kernel is monomorphized on
+    // "has rolling" (k_r > 0 or c_r > 0) and "has dashpots" (any c > 0).
+    use cosdem_worker::spec::{ContactParams, NormalModel, RollingModel, TangentialModel};
+    let full = ContactParams::default();
+    let laws = [
+        ("full law (rolling k_r = 25, no dashpots)", full.clone()),
+        (
+            "rolling k_r = 0 (coulomb model)",
+            ContactParams {
+                rolling: RollingModel::Coulomb { k_r: 0.0, mu_r: 0.2, c_r: 0.0 },
+                ..full.clone()
+            },
+        ),
+        ("rolling none", ContactParams { rolling: RollingModel::None, ..full.clone() }),
+        (
+            "rolling none, tangential none",
+            ContactParams {
+                rolling: RollingModel::None,
+                tangential: TangentialModel::None,
+                ..full.clone()
+            },
+        ),
+        (
+            "full law + dashpots (c_n = 10)",
+            ContactParams { normal: NormalModel::LinearDashpot { k_n: 6.7e7, c_n: 10.0 }, ..full },
+        ),
+    ];
+    let n = 1600;
+    let steps = (work / n as f64).max(200.0) as u64;
+    for (name, law) in laws {
+        let r = cosdem_worker::bench::rate_with(n, steps, law)?;
+        println!("{:>6} discs {name}: {:.3e} particle-steps/s", r.discs, r.rate);
+    }
     let (n, steps, conv, wall) = cosdem_worker::bench::relaxation()?;
     println!(
         "relaxation 0.0784 m^2 ({n} discs, e_yy = -1e-3): {steps} steps, converged {conv}, {wall:.3} s"

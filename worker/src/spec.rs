@@ -226,6 +226,15 @@ pub struct RelaxationSpec {
     pub density_scale: f64,
     /// Verlet skin as a fraction of the smallest radius (default 0.5).
     pub skin: f64,
+    /// Skip threshold (default 0 = off): a solve whose deformation since the last relaxation
+    /// measures below it, `max(|dF_ij|, |dw|, (sqrt(V)/2) |dk_i|)`, is not relaxed; the last
+    /// relaxed stress plus tangent times the strain increment answers (see
+    /// [`crate::assembly`]'s `shortcut` module).
+    pub skip_below: f64,
+    /// Elastic shortcut (default false): answer through the tangent, without a relaxation,
+    /// while the increment since the last relaxation keeps every contact sticking and none
+    /// opens or closes (checked on the affine jump with a 10 % margin).
+    pub elastic_shortcut: bool,
 }
 
 impl Default for RelaxationSpec {
@@ -239,6 +248,8 @@ impl Default for RelaxationSpec {
             safety: 0.5,
             density_scale: 1.0,
             skin: 0.5,
+            skip_below: 0.0,
+            elastic_shortcut: false,
         }
     }
 }
@@ -458,6 +469,7 @@ impl AssemblySpec {
                 "must be in (0, 2] (fraction of r_min)",
             ));
         }
+        non_negative("relaxation.skip_below", r.skip_below)?;
         match &r.driver {
             Driver::Cundall { alpha } => {
                 if !(*alpha >= 0.0 && *alpha < 1.0) {

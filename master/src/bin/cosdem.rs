@@ -312,6 +312,12 @@ fn run(args: RunArgs) -> Result<()> {
         s.wall_seconds,
         dir.display()
     );
+    if s.skipped_relaxations + s.linear_answers > 0 {
+        println!(
+            "answers without relaxation: {} skipped, {} linear (largest stress-error bound {:.3e} Pa)",
+            s.skipped_relaxations, s.linear_answers, s.max_error_bound
+        );
+    }
     outcome.with_context(|| format!("run stopped; finished steps are in {}", dir.display()))?;
     Ok(())
 }

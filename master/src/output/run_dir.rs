@@ -16,6 +16,7 @@ use super::vtk::{gauss_point_piece, nodal_piece, write_vtu};
 use super::{OutputError, Result, write_atomic};
 use crate::post::CurveMetrics;
 use crate::solve::{SolutionView, StepObserver, StepReport};
+use cosdem_common::Answer;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -41,6 +42,8 @@ pub struct RunSettings {
     pub shortening: f64,
     /// Node set whose reaction is the load (compression positive: `-R_y`).
     pub load_set: String,
+    /// Factor from that reaction to the reported load (2 on a half or quarter mesh).
+    pub load_scale: f64,
     /// Write VTK every this many steps (0: never).
     pub vtk_every: usize,
     /// Internal length for the equivalent strain (m).
@@ -66,6 +69,14 @@ pub struct Summary {
     pub dem_steps: u64,
     /// Gauss-point relaxations that hit their step cap in converged steps.
     pub capped_relaxations: u64,
+    /// Gauss-point answers of converged steps given without a relaxation because the
+    /// increment was below `relaxation.skip_below`.
+    pub skipped_relaxations: u64,
+    /// Gauss-point answers of converged steps given through the tangent by the elastic
+    /// shortcut (`relaxation.elastic_shortcut`).
+    pub linear_answers: u64,
+    /// Largest reported stress-error bound of those answers (Pa).
+    pub max_error_bound: f64,
     /// Step cuts taken.
     pub cuts: u64,
     /// Steps accepted under `newton.tolerated_residual` (ran out of iterations above the
@@ -118,6 +129,9 @@ impl RunWriter {
             metrics: CurveMetrics::default(),
             dem_steps: 0,
             capped_relaxations: 0,
+            skipped_relaxations: 0,
+            linear_answers: 0,
+            max_error_bound: 0.0,
             cuts: 0,
             tolerated_steps: 0,
             wall_seconds: 0.0,
@@ -212,7 +226,8 @@ impl RunWriter {
 impl StepObserver for RunWriter {
     fn on_step(&mut self, report: &StepReport, view: &SolutionView<'_>) -> crate::Result<()> {
         let displacement = report.load_factor * self.settings.shortening;
-        let load = -report.reactions.get(&self.settings.load_set).map_or(0.0, |r| r[1]);
+        let load = -self.settings.load_scale
+            * report.reactions.get(&self.settings.load_set).map_or(0.0, |r| r[1]);
         let dem_steps: u64 = view.gauss_points.iter().map(|g| g.diagnostics.steps).sum();
         let capped = view
             .gauss_points
@@ -224,6 +239,15 @@ impl StepObserver for RunWriter {
         self.summary.displacement = displacement;
         self.summary.dem_steps += dem_steps;
         self.summary.capped_relaxations += capped;
+        for g in view.gauss_points {
+            let d = &g.diagnostics;
+            match d.answer {
+                Answer::Relaxed => {}
+                Answer::Skipped => self.summary.skipped_relaxations += 1,
+                Answer::Linear => self.summary.linear_answers += 1,
+            }
+            self.summary.max_error_bound = self.summary.max_error_bound.max(d.error_bound);
+        }
         self.summary.cuts += u64::from(report.cuts);
         self.summary.tolerated_steps += u64::from(report.tolerated);
         self.summary.metrics = CurveMetrics::from_curve(&self.curve, self.settings.linear_range);

@@ -72,6 +72,7 @@ pub(super) fn from_packing(spec: &AssemblySpec, law: Law, p: Packing) -> Result<
             dynamics,
             pairs: PairList::default(),
             target: MacroDeformation::IDENTITY,
+            relaxed: None,
         },
         trial: None,
         work: Work::default(),

@@ -3,7 +3,7 @@ use crate::error::{Error, Result};
 use crate::homogenize::for_each_contact;
 use serde::{Deserialize, Serialize};
 
-const MAGIC: &[u8; 8] = b"CDEMASM1";
+const MAGIC: &[u8; 8] = b"CDEMASM2";
 
 /// One active contact in a snapshot.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -49,7 +49,7 @@ struct Body {
 }
 
 impl Assembly {
-    /// Encodes spec, reference, committed and trial state: the header `CDEMASM1`, the spec
+    /// Encodes spec, reference, committed and trial state: the header `CDEMASM2`, the spec
     /// as length-prefixed JSON (its tagged enums need a self-describing format), then the
     /// state in bincode 2 (f64 as raw little-endian bit patterns: bit-exact).
     pub fn to_bytes(&self) -> Vec<u8> {
@@ -75,7 +75,7 @@ impl Assembly {
     pub fn from_bytes(bytes: &[u8]) -> Result<Assembly> {
         let m = MAGIC.len();
         if bytes.len() < m + 8 || &bytes[..m] != MAGIC {
-            return Err(Error::Decode("missing CDEMASM1 header".into()));
+            return Err(Error::Decode("missing CDEMASM2 header".into()));
         }
         let len = u64::from_le_bytes(bytes[m..m + 8].try_into().expect("8 bytes")) as usize;
         let rest = &bytes[m + 8..];

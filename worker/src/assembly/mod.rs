@@ -5,10 +5,13 @@
 mod build;
 /// Byte encoding and snapshots.
 mod io;
+/// Answers without a relaxation: the skip threshold and the elastic shortcut.
+mod shortcut;
 /// The trial solve: affine predictor, relaxation, homogenization, tangents.
 mod solve;
 
 pub use io::{ContactForce, Snapshot};
+pub use shortcut::{MARGIN as SHORTCUT_MARGIN, Relaxed};
 
 use crate::boundary::penalty::Penalty;
 use crate::boundary::periodic;
@@ -60,6 +63,9 @@ pub struct State {
     pub pairs: PairList,
     /// The macro deformation this state was relaxed to.
     pub target: MacroDeformation,
+    /// What the relaxation to `target` answered (None for a state that was never relaxed by
+    /// `solve`, e.g. the initial packing): the base of the shortcuts.
+    pub relaxed: Option<Relaxed>,
 }
 
 /// A disc assembly backing one Gauss point.

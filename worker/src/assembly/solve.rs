@@ -11,9 +11,24 @@ use cosdem_common::{MacroDeformation, MicroDiagnostics, MicroResponse};
 use std::time::Instant;
 
 impl Assembly {
-    /// Trial solve: from the committed state (or the last trial with `warm_start`), jump
-    /// affinely to `target`, relax, homogenize. The trial state is kept for `commit`.
+    /// Trial solve: the shortcut answer when `relaxation.skip_below` or
+    /// `relaxation.elastic_shortcut` allows one (no trial state then), else
+    /// [`Assembly::solve_relaxed`].
     pub fn solve(&mut self, target: &MacroDeformation) -> Result<MicroResponse> {
+        target.validate()?;
+        if let Some(answer) = self.shortcut(target) {
+            // Answered from the committed (last relaxed) state: no trial, so a commit keeps
+            // the last relaxed state and the increment keeps accumulating.
+            self.trial = None;
+            return Ok(answer);
+        }
+        self.solve_relaxed(target)
+    }
+
+    /// Trial solve by relaxation, whatever the shortcut settings: from the committed state (or
+    /// the last trial with `warm_start`), jump affinely to `target`, relax, homogenize. The
+    /// trial state is kept for `commit`.
+    pub fn solve_relaxed(&mut self, target: &MacroDeformation) -> Result<MicroResponse> {
         target.validate()?;
         let t0 = Instant::now();
         let start = match (&self.trial, self.spec.warm_start) {
@@ -36,6 +51,7 @@ impl Assembly {
             sliding_fraction: h.fabric.sliding_fraction,
             rolling_fraction: h.fabric.rolling_fraction,
             wall_seconds: t0.elapsed().as_secs_f64(),
+            ..Default::default()
         };
         // Never NaN on the wire: a non-finite answer is an error of this Gauss point.
         let det = st.target.det();
@@ -45,6 +61,14 @@ impl Assembly {
         if !tangent.iter().flatten().all(|v| v.is_finite()) {
             return Err(Error::NonFinite { what: "tangent", det });
         }
+        let mut st = st;
+        st.relaxed = Some(super::Relaxed {
+            stress: h.stress,
+            tangent,
+            contacts: h.fabric.contacts,
+            sliding_fraction: h.fabric.sliding_fraction,
+            rolling_fraction: h.fabric.rolling_fraction,
+        });
         self.trial = Some(st);
         Ok(MicroResponse { stress: h.stress, tangent, diagnostics })
     }
@@ -168,6 +192,7 @@ impl Assembly {
         }
         d.stop();
         st.target = *target;
+        st.relaxed = None;
         let skin = self.spec.relaxation.skin * self.refc.r_min;
         *pl = broadphase::build(&d.x, &d.y, r, skin, self.domain(target), pl);
     }

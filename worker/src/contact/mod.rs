@@ -75,3 +75,31 @@ impl Law {
         Self { ks: 0.0, cs: 0.0, mu_s: 0.0, kr: 0.0, cr: 0.0, mu_r: 0.0, ..*self }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A sub-model with zero coefficients selects the kernel without it (issue 6, item 3b):
+    /// `k_r = 0` and `c_r = 0` through the Coulomb rolling model is the no-rolling kernel, and
+    /// zero dashpots are the undamped one, exactly as the `none` models are.
+    #[test]
+    fn zero_coefficients_select_the_kernel_without_the_sub_model() {
+        let off = ContactParams {
+            rolling: RollingModel::Coulomb { k_r: 0.0, mu_r: 0.2, c_r: 0.0 },
+            ..ContactParams::default()
+        };
+        let law = Law::from_params(&off);
+        assert!(!law.has_rolling(), "k_r = 0, c_r = 0 must skip the rolling work");
+        assert!(!law.has_damping(), "c = 0 everywhere must skip the dashpot terms");
+        let none = Law::from_params(&ContactParams { rolling: RollingModel::None, ..off });
+        assert!(!none.has_rolling());
+        let on = Law::from_params(&ContactParams::default());
+        assert!(on.has_rolling() && !on.has_damping());
+        let damped = Law::from_params(&ContactParams {
+            normal: NormalModel::LinearDashpot { k_n: 6.7e7, c_n: 1.0 },
+            ..ContactParams::default()
+        });
+        assert!(damped.has_damping());
+    }
+}

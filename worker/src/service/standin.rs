@@ -181,6 +181,7 @@ fn respond(
         sliding_fraction: d,
         rolling_fraction: 0.0,
         wall_seconds: 0.0,
+        ..Default::default()
     };
     Ok((MicroResponse { stress, tangent, diagnostics }, kappa))
 }
