@@ -3,6 +3,11 @@
 //! costs next to the DEM side. Run through `cosdem bench ...` (release build); every figure is
 //! printed, nothing here is a test.
 //!
+//! # 0. Coupling floor ([`rpc_floor`])
+//! The same evaluate + commit cycle on stand-in assemblies that do no work: the time per
+//! iteration against the batch size, fitted by `a + b n` (fixed cost per iteration, cost per
+//! Gauss point). Divided by the DEM solve time it bounds the overhead from below.
+//!
 //! # Workload
 //! Every measurement drives the same deterministic sequence: `points` hexagonal assemblies
 //! (disc radius 5 mm, about `discs` discs each, default contact law and relaxation; see
@@ -25,15 +30,23 @@
 //! - **tcp**: [`Pool::connect`] to one `cosdem-worker listen --threads 1` process spawned on
 //!   a free loopback port (a separate process: real sockets, real HTTP/2 framing).
 //!
-//! Time per Gauss point per iteration = wall time / (points x iterations); overhead =
-//! (pool time - direct time) / direct time, computed per repetition (the pool run against the
-//! direct run of the same repetition) and reported as median [min .. max]. On a loaded
-//! machine that difference of two runs is noisy (load changes between runs), so each run
-//! also reports its in-run overhead ([`Run::in_run_overhead`]): its wall time against the sum
-//! of the wall times its solves measured themselves inside `Assembly::solve` (the DEM work
-//! alone), both from the same run. For the pool this is everything the coupling adds (RPC,
-//! (de)serialization, scheduling, the commit that ships states back); for direct calls it is
-//! the loop and `commit` only, the floor to compare with.
+//! Time per Gauss point per iteration = wall time / (points x iterations).
+//!
+//! **Overhead (the figure: RPC overhead per Gauss point per iteration against the DEM
+//! solve time)** = (wall time of the run - sum of its solves' own wall times / parallelism) /
+//! (sum of the solves' own wall times / parallelism), both from the same run
+//! ([`Run::in_run_overhead`]; parallelism = 1 here: one worker, one relaxation thread, so the
+//! solves run one after the other). The solves' own wall times are measured inside
+//! `Assembly::solve`, wherever it ran, so the numerator is everything the coupling adds and
+//! does not hide behind a solve: RPC round trips, (de)serialization, thread hand-offs,
+//! scheduling, the commit (and, every `export_every` commits, the states shipped back). For
+//! the direct loop the same figure is the floor (the loop and `commit`). Being measured
+//! within one run it is insensitive to load changes between runs; it is not insensitive to
+//! the load during the run: on an oversubscribed machine every thread hand-off waits for a
+//! time slice, which inflates it (see [`rpc_floor`] for the coupling's cost on its own).
+//! The difference of two runs, (pool time - direct time) / direct time, per repetition, is
+//! printed too, but load changes between the runs make it much noisier than the overhead
+//! itself.
 //!
 //! # 2. Scaling ([`scaling`])
 //! The step time of a job of `points` Gauss points (default 64): one iteration = one
@@ -303,8 +316,11 @@ fn single_thread_config() -> PoolConfig {
     PoolConfig { in_process_threads: 1, ..PoolConfig::default() }
 }
 
+/// One relaxation thread per worker; no rebalancing: the assemblies are identical, so the
+/// placement by disc count is already even, and timing noise on a loaded machine must not
+/// migrate assemblies in the middle of a measurement.
 fn bench_config(export_every: u64) -> PoolConfig {
-    PoolConfig { export_every, ..single_thread_config() }
+    PoolConfig { export_every, rebalance_threshold: f64::INFINITY, ..single_thread_config() }
 }
 
 fn in_process_pool(workers: usize, export_every: u64) -> BenchResult<Pool> {
@@ -370,7 +386,12 @@ pub fn overhead(w: &Workload, out: &mut dyn Write) -> BenchResult<()> {
                     discs = n;
                     d
                 }
-                1 => run_pool(&mut in_process_pool(1, w.export_every)?, &spec, w.points, w.iterations)?,
+                1 => run_pool(
+                    &mut in_process_pool(1, w.export_every)?,
+                    &spec,
+                    w.points,
+                    w.iterations,
+                )?,
                 _ => {
                     let p = procs.as_ref().ok_or("no worker process")?;
                     run_pool(&mut tcp_pool(p, w.export_every)?, &spec, w.points, w.iterations)?
@@ -532,12 +553,10 @@ struct LoopbackStandIn {
 impl LoopbackStandIn {
     fn start() -> BenchResult<LoopbackStandIn> {
         use cosdem_worker::service::{StandIn, WorkerConfig, bind, serve_listener};
-        let rt = tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?;
-        let config = WorkerConfig {
-            listen: "127.0.0.1:0".parse()?,
-            threads: 1,
-            ..WorkerConfig::default()
-        };
+        let rt =
+            tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?;
+        let config =
+            WorkerConfig { listen: "127.0.0.1:0".parse()?, threads: 1, ..WorkerConfig::default() };
         let listener = rt.block_on(bind(&config))?;
         let addr = listener.local_addr()?.to_string();
         rt.spawn(serve_listener(listener, config, StandIn::new(), std::future::pending()));

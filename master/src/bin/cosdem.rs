@@ -13,9 +13,7 @@ use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use cosdem_common::GaussPointId;
 use cosdem_common::micro::{AssemblyRequest, BoundaryKind};
-use cosdem_master::bench::{
-    Workload, fe_versus_dem, overhead, rpc_floor, scaling, worker_binary,
-};
+use cosdem_master::bench::{Workload, fe_versus_dem, overhead, rpc_floor, scaling, worker_binary};
 use cosdem_master::job::{Job, MaterialSection};
 use cosdem_master::material::{ElasticCosserat, Material};
 use cosdem_master::output::run_dir::{RunSettings, RunWriter};

@@ -290,19 +290,27 @@ type Job<T> = std::pin::Pin<Box<dyn Future<Output = Result<T, Status>> + Send>>;
 
 type Outcomes = BTreeMap<GaussPointId, Result<MicroResponse, String>>;
 
-/// Runs one job per worker concurrently; a lost task becomes an INTERNAL status.
-async fn fan_out<T: Send + 'static>(jobs: Vec<(usize, Job<T>)>) -> Vec<(usize, Result<T, Status>)> {
-    let mut set = tokio::task::JoinSet::new();
-    for (w, job) in jobs {
-        set.spawn(async move { (w, job.await) });
-    }
-    let mut out = Vec::new();
-    while let Some(r) = set.join_next().await {
-        match r {
-            Ok(x) => out.push(x),
-            Err(e) => tracing::error!("pool task lost: {e}"),
+/// Runs one job per worker concurrently, polled on the calling task (the thread blocked in
+/// `block_on`): no task is spawned per job, so a call costs no hand-off to a runtime thread
+/// and back (two thread wake-ups per call, which a loaded machine makes slow). The jobs only
+/// await the network; their results are sorted by worker.
+async fn fan_out<T>(jobs: Vec<(usize, Job<T>)>) -> Vec<(usize, Result<T, Status>)> {
+    let mut pending = jobs;
+    let mut out = Vec::with_capacity(pending.len());
+    std::future::poll_fn(|cx| {
+        let mut i = 0;
+        while i < pending.len() {
+            match pending[i].1.as_mut().poll(cx) {
+                std::task::Poll::Ready(r) => {
+                    let (w, _) = pending.swap_remove(i);
+                    out.push((w, r));
+                }
+                std::task::Poll::Pending => i += 1,
+            }
         }
-    }
+        if pending.is_empty() { std::task::Poll::Ready(()) } else { std::task::Poll::Pending }
+    })
+    .await;
     out.sort_by_key(|(w, _)| *w);
     out
 }
@@ -869,7 +877,11 @@ impl Pool {
                                 Some(s) => self.history.store(s),
                                 None => self.history.record(
                                     *id,
-                                    Increment { step, iteration: trial.iteration, target: targets[id] },
+                                    Increment {
+                                        step,
+                                        iteration: trial.iteration,
+                                        target: targets[id],
+                                    },
                                 ),
                             }
                         }
