@@ -3,6 +3,11 @@
 //! costs next to the DEM side. Run through `cosdem bench ...` (release build); every figure is
 //! printed, nothing here is a test.
 //!
+//! # 0. Coupling floor ([`rpc_floor`])
+//! The same evaluate + commit cycle on stand-in assemblies that do no work: the time per
+//! iteration against the batch size, fitted by `a + b n` (fixed cost per iteration, cost per
+//! Gauss point). Divided by the DEM solve time it bounds the overhead from below.
+//!
 //! # Workload
 //! Every measurement drives the same deterministic sequence: `points` hexagonal assemblies
 //! (disc radius 5 mm, about `discs` discs each, default contact law and relaxation; see
@@ -25,15 +30,23 @@
 //! - **tcp**: [`Pool::connect`] to one `cosdem-worker listen --threads 1` process spawned on
 //!   a free loopback port (a separate process: real sockets, real HTTP/2 framing).
 //!
-//! Time per Gauss point per iteration = wall time / (points x iterations); overhead =
-//! (pool time - direct time) / direct time, computed per repetition (the pool run against the
-//! direct run of the same repetition) and reported as median [min .. max]. On a loaded
-//! machine that difference of two runs is noisy (load changes between runs), so each run
-//! also reports its in-run overhead ([`Run::in_run_overhead`]): its wall time against the sum
-//! of the wall times its solves measured themselves inside `Assembly::solve` (the DEM work
-//! alone), both from the same run. For the pool this is everything the coupling adds (RPC,
-//! (de)serialization, scheduling, the commit that ships states back); for direct calls it is
-//! the loop and `commit` only, the floor to compare with.
+//! Time per Gauss point per iteration = wall time / (points x iterations).
+//!
+//! **Overhead (the issue's figure: RPC overhead per Gauss point per iteration against the DEM
+//! solve time)** = (wall time of the run - sum of its solves' own wall times / parallelism) /
+//! (sum of the solves' own wall times / parallelism), both from the same run
+//! ([`Run::in_run_overhead`]; parallelism = 1 here: one worker, one relaxation thread, so the
+//! solves run one after the other). The solves' own wall times are measured inside
+//! `Assembly::solve`, wherever it ran, so the numerator is everything the coupling adds and
+//! does not hide behind a solve: RPC round trips, (de)serialization, thread hand-offs,
+//! scheduling, the commit (and, every `export_every` commits, the states shipped back). For
+//! the direct loop the same figure is the floor (the loop and `commit`). Being measured
+//! within one run it is insensitive to load changes between runs; it is not insensitive to
+//! the load during the run: on an oversubscribed machine every thread hand-off waits for a
+//! time slice, which inflates it (see [`rpc_floor`] for the coupling's cost on its own).
+//! The difference of two runs, (pool time - direct time) / direct time, per repetition, is
+//! printed too, but load changes between the runs make it much noisier than the overhead
+//! itself.
 //!
 //! # 2. Scaling ([`scaling`])
 //! The step time of a job of `points` Gauss points (default 64): one iteration = one
@@ -303,12 +316,19 @@ fn single_thread_config() -> PoolConfig {
     PoolConfig { in_process_threads: 1, ..PoolConfig::default() }
 }
 
-fn in_process_pool(workers: usize) -> BenchResult<Pool> {
-    Ok(Pool::in_process(workers, single_thread_config(), |_| Dem)?)
+/// One relaxation thread per worker; no rebalancing: the assemblies are identical, so the
+/// placement by disc count is already even, and timing noise on a loaded machine must not
+/// migrate assemblies in the middle of a measurement.
+fn bench_config(export_every: u64) -> PoolConfig {
+    PoolConfig { export_every, rebalance_threshold: f64::INFINITY, ..single_thread_config() }
 }
 
-fn tcp_pool(procs: &WorkerProcesses) -> BenchResult<Pool> {
-    Ok(Pool::connect(&procs.addresses, single_thread_config())?)
+fn in_process_pool(workers: usize, export_every: u64) -> BenchResult<Pool> {
+    Ok(Pool::in_process(workers, bench_config(export_every), |_| Dem)?)
+}
+
+fn tcp_pool(procs: &WorkerProcesses, export_every: u64) -> BenchResult<Pool> {
+    Ok(Pool::connect(&procs.addresses, bench_config(export_every))?)
 }
 
 fn check_same(label: &str, a: &Run, b: &Run) -> BenchResult<()> {
@@ -336,6 +356,8 @@ pub struct Workload {
     pub repeats: usize,
     /// The `cosdem-worker` binary for the TCP runs; `None` skips them.
     pub worker_bin: Option<PathBuf>,
+    /// [`PoolConfig::export_every`] of the pools (1: every commit ships every state back).
+    pub export_every: u64,
 }
 
 /// Figure 1: direct versus in-process pool versus TCP pool, one worker with one thread.
@@ -364,10 +386,15 @@ pub fn overhead(w: &Workload, out: &mut dyn Write) -> BenchResult<()> {
                     discs = n;
                     d
                 }
-                1 => run_pool(&mut in_process_pool(1)?, &spec, w.points, w.iterations)?,
+                1 => run_pool(
+                    &mut in_process_pool(1, w.export_every)?,
+                    &spec,
+                    w.points,
+                    w.iterations,
+                )?,
                 _ => {
                     let p = procs.as_ref().ok_or("no worker process")?;
-                    run_pool(&mut tcp_pool(p)?, &spec, w.points, w.iterations)?
+                    run_pool(&mut tcp_pool(p, w.export_every)?, &spec, w.points, w.iterations)?
                 }
             });
         }
@@ -405,9 +432,9 @@ pub fn overhead(w: &Workload, out: &mut dyn Write) -> BenchResult<()> {
     writeln!(
         out,
         "RPC overhead: {} Gauss points x {} iterations of {discs}-disc hexagonal assemblies \
-         ({steps_per_solve:.0} relaxation steps per solve), 1 worker x 1 thread, {} repetitions; \
-         per Gauss point per iteration, median [min .. max]:",
-        w.points, w.iterations, w.repeats
+         ({steps_per_solve:.0} relaxation steps per solve), 1 worker x 1 thread, states exported \
+         every {} commits, {} repetitions; per Gauss point per iteration, median [min .. max]:",
+        w.points, w.iterations, w.export_every, w.repeats
     )?;
     writeln!(out, "  direct Assembly::solve : {} ms", Spread::of(&direct).show(1e3, 3))?;
     writeln!(
@@ -460,8 +487,8 @@ pub fn scaling(w: &Workload, out: &mut dyn Write) -> BenchResult<()> {
             let mut runs = Vec::new();
             for (k, n) in [1usize, 2].into_iter().enumerate() {
                 let mut pool = match procs {
-                    None => in_process_pool(n)?,
-                    Some(p) => tcp_pool(&p[k])?,
+                    None => in_process_pool(n, w.export_every)?,
+                    Some(p) => tcp_pool(&p[k], w.export_every)?,
                 };
                 if pool.live_workers() != n {
                     return Err(format!(
@@ -502,15 +529,124 @@ pub fn scaling(w: &Workload, out: &mut dyn Write) -> BenchResult<()> {
     writeln!(
         out,
         "Scaling: step time (one evaluate of {} Gauss points + commit) of {discs}-disc \
-         assemblies, workers of 1 thread each, {} iterations x {} repetitions, median [min .. max]; \
-         {} cores available:",
+         assemblies, workers of 1 thread each, states exported every {} commits, {} iterations x \
+         {} repetitions, median [min .. max]; {} cores available:",
         w.points,
+        w.export_every,
         w.iterations,
         w.repeats,
         std::thread::available_parallelism().map_or(1, |c| c.get())
     )?;
     for line in summary {
         writeln!(out, "{line}")?;
+    }
+    Ok(())
+}
+
+/// A loopback TCP worker serving the stand-in model inside this process (its own 2-thread
+/// runtime, like a worker process's), for [`rpc_floor`].
+struct LoopbackStandIn {
+    _rt: tokio::runtime::Runtime,
+    addr: String,
+}
+
+impl LoopbackStandIn {
+    fn start() -> BenchResult<LoopbackStandIn> {
+        use cosdem_worker::service::{StandIn, WorkerConfig, bind, serve_listener};
+        let rt =
+            tokio::runtime::Builder::new_multi_thread().worker_threads(2).enable_all().build()?;
+        let config =
+            WorkerConfig { listen: "127.0.0.1:0".parse()?, threads: 1, ..WorkerConfig::default() };
+        let listener = rt.block_on(bind(&config))?;
+        let addr = listener.local_addr()?.to_string();
+        rt.spawn(serve_listener(listener, config, StandIn::new(), std::future::pending()));
+        Ok(LoopbackStandIn { _rt: rt, addr })
+    }
+}
+
+/// One run of the workload of [`run_pool`] on stand-in assemblies that do no work: what the
+/// coupling alone costs per iteration (evaluate + commit) for `points` Gauss points.
+fn run_floor(pool: &mut Pool, points: usize, iterations: u64) -> BenchResult<f64> {
+    let ids: Vec<GaussPointId> = (0..points as u32).map(|e| GaussPointId::new(e, 0)).collect();
+    let request = AssemblyRequest {
+        spec_json: br#"{"discs": 400, "work_per_disc": 0}"#.to_vec(),
+        boundary: BoundaryKind::Unspecified,
+        disc_count_hint: 0,
+    };
+    pool.create_assemblies(&ids, &request)?;
+    let t0 = Instant::now();
+    for k in 1..=iterations {
+        let deformation = target(k);
+        let inputs: Vec<MaterialInput> =
+            ids.iter().map(|&gauss_point| MaterialInput { gauss_point, deformation }).collect();
+        pool.evaluate(TrialId { step: k, iteration: 0 }, &inputs)?;
+        pool.commit(k)?;
+    }
+    let per_iteration = t0.elapsed().as_secs_f64() / iterations as f64;
+    pool.release();
+    Ok(per_iteration)
+}
+
+/// Least-squares line `y = a + b x`.
+fn fit_line(x: &[f64], y: &[f64]) -> (f64, f64) {
+    let n = x.len() as f64;
+    let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
+    let sxy: f64 = x.iter().zip(y).map(|(a, b)| (a - mx) * (b - my)).sum();
+    let sxx: f64 = x.iter().map(|a| (a - mx) * (a - mx)).sum();
+    let b = if sxx > 0.0 { sxy / sxx } else { 0.0 };
+    (my - b * mx, b)
+}
+
+/// Figure 0: the coupling's own cost, without DEM work. One worker x one thread holds
+/// `points` stand-in assemblies whose solve does no work (microseconds); per iteration one
+/// evaluate (one SolveBatch) and one commit, as in [`overhead`]. The time per iteration
+/// against the batch size, fitted by `a + b n`, splits it into the fixed cost per iteration
+/// (`a`: the SolveBatch and Commit round trips, thread hand-offs) and the cost per Gauss
+/// point (`b`: (de)serialization, one streamed message, one relaxation task). In-process
+/// over the duplex transport, and over loopback TCP to a worker served by this process.
+pub fn rpc_floor(
+    sizes: &[usize],
+    iterations: u64,
+    repeats: usize,
+    out: &mut dyn Write,
+) -> BenchResult<()> {
+    let tcp = LoopbackStandIn::start()?;
+    let config = PoolConfig { rebalance_threshold: f64::INFINITY, ..single_thread_config() };
+    writeln!(
+        out,
+        "Coupling floor: stand-in assemblies with no work, 1 worker x 1 thread, evaluate + \
+         commit per iteration, {iterations} iterations x {repeats} repetitions, median [min .. max]:"
+    )?;
+    for transport in ["in-process", "tcp"] {
+        let mut medians = Vec::new();
+        for &n in sizes {
+            let mut v = Vec::new();
+            for _ in 0..repeats {
+                let mut pool = match transport {
+                    "tcp" => Pool::connect(std::slice::from_ref(&tcp.addr), config.clone())?,
+                    _ => Pool::in_process(1, config.clone(), |_| {
+                        cosdem_worker::service::StandIn::new()
+                    })?,
+                };
+                v.push(run_floor(&mut pool, n, iterations)?);
+            }
+            let s = Spread::of(&v);
+            writeln!(
+                out,
+                "  {transport:<10} {n:>4} points: {} ms per iteration, {:.1} us per point",
+                s.show(1e3, 3),
+                s.median / n as f64 * 1e6
+            )?;
+            medians.push(s.median);
+        }
+        let x: Vec<f64> = sizes.iter().map(|&n| n as f64).collect();
+        let (a, b) = fit_line(&x, &medians);
+        writeln!(
+            out,
+            "  {transport:<10} fit: {:.3} ms fixed per iteration + {:.1} us per Gauss point",
+            a * 1e3,
+            b * 1e6
+        )?;
     }
     Ok(())
 }

@@ -95,8 +95,9 @@ async fn solve_batch_and_commit_retries_are_idempotent() {
 #[test]
 fn pool_commit_twice_is_a_no_op() {
     use cosdem_master::material::{Material, MaterialInput, TrialId};
-    let mut pool =
-        cosdem_master::pool::Pool::in_process(2, test_config(), |_| StandIn::new()).unwrap();
+    // Export at every commit, so that the stored states show the commit.
+    let config = cosdem_master::pool::PoolConfig { export_every: 1, ..test_config() };
+    let mut pool = cosdem_master::pool::Pool::in_process(2, config, |_| StandIn::new()).unwrap();
     create(&mut pool, 10, 1);
     let inputs: Vec<_> = gauss_points()
         .into_iter()

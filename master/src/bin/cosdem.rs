@@ -11,7 +11,7 @@
 
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
-use cosdem_master::bench::{Workload, fe_versus_dem, overhead, scaling, worker_binary};
+use cosdem_master::bench::{Workload, fe_versus_dem, overhead, rpc_floor, scaling, worker_binary};
 use cosdem_master::job::Job;
 use cosdem_master::output::run_dir::RunWriter;
 use cosdem_master::pool::PoolConfig;
@@ -42,6 +42,9 @@ enum Command {
 
 #[derive(Subcommand)]
 enum BenchWhat {
+    /// The coupling's own cost without DEM work (stand-in assemblies): fixed per iteration
+    /// and per Gauss point, in-process and loopback TCP.
+    Floor(FloorArgs),
     /// RPC overhead per Gauss point per iteration: direct vs in-process pool vs loopback TCP.
     Overhead(OverheadArgs),
     /// Step time of a 64-Gauss-point job with 1 and 2 workers of one thread each.
@@ -111,6 +114,9 @@ struct CommonArgs {
     /// Skip the TCP runs.
     #[arg(long)]
     no_tcp: bool,
+    /// Export the committed states every this many commits (the pool's `export_every`).
+    #[arg(long, default_value_t = cosdem_master::pool::PoolConfig::default().export_every)]
+    export_every: u64,
 }
 
 #[derive(clap::Args)]
@@ -144,6 +150,19 @@ struct ScalingArgs {
 }
 
 #[derive(clap::Args)]
+struct FloorArgs {
+    /// Batch sizes (Gauss points per worker per iteration).
+    #[arg(long, value_delimiter = ',', default_values_t = [1usize, 4, 16, 64])]
+    points: Vec<usize>,
+    /// Iterations per run.
+    #[arg(long, default_value_t = 200)]
+    iterations: u64,
+    /// Repetitions.
+    #[arg(long, default_value_t = 3)]
+    repeats: usize,
+}
+
+#[derive(clap::Args)]
 struct FeArgs {
     /// Elements per side of the Q8 panel.
     #[arg(long, default_value_t = 10)]
@@ -165,13 +184,21 @@ fn workload(discs: usize, points: usize, iterations: u64, c: &CommonArgs) -> Res
     } else {
         Some(worker_binary(c.worker_bin.as_deref()).map_err(|e| anyhow::anyhow!("{e}"))?)
     };
-    Ok(Workload { discs, points, iterations, repeats: c.repeats, worker_bin })
+    Ok(Workload {
+        discs,
+        points,
+        iterations,
+        repeats: c.repeats,
+        worker_bin,
+        export_every: c.export_every,
+    })
 }
 
 fn bench(what: BenchWhat) -> Result<()> {
     let out = &mut std::io::stdout();
     let e = |e: Box<dyn std::error::Error + Send + Sync>| anyhow::anyhow!("{e}");
     match what {
+        BenchWhat::Floor(a) => rpc_floor(&a.points, a.iterations, a.repeats, out).map_err(e),
         BenchWhat::Overhead(a) => {
             overhead(&workload(a.discs, a.points, a.iterations, &a.common)?, out).map_err(e)
         }

@@ -219,12 +219,14 @@ impl Link {
         .await
     }
 
-    /// Commits trial (step, iteration) of `ids`, returning their new committed states.
+    /// Commits trial (step, iteration) of `ids`, returning their new committed states if
+    /// `export` (else none).
     pub async fn commit(
         &self,
         ids: &[GaussPointId],
         step: u64,
         iteration: u32,
+        export: bool,
         timeout: Duration,
     ) -> Result<Vec<AssemblyState>, Status> {
         let mut c = self.client.clone();
@@ -232,7 +234,7 @@ impl Link {
             step,
             iteration,
             ids: ids.iter().map(|i| (*i).into()).collect(),
-            export_state: true,
+            export_state: export,
         };
         let r = bounded(timeout, c.commit(with_timeout(req, timeout))).await?.into_inner();
         r.states.into_iter().map(|s| s.try_into().map_err(bad_reply)).collect()

@@ -14,17 +14,22 @@
 //! plain thread, or from `tokio::task::spawn_blocking`).
 //!
 //! # Fault tolerance
-//! The master keeps every assembly's last committed state: `Commit` asks each worker to
-//! return the newly committed states in its reply (`export_state`), so each commit costs one
-//! copy of every assembly's state over the network and in master memory (for the DEM: about
-//! positions, rotations and contact history of every disc, tens of bytes per disc). When a
-//! worker fails (transport error, deadline, lost assemblies), it is marked dead, its
-//! assemblies are imported on the remaining workers from those states, and the Gauss points
-//! it owed are solved again there; a worker lost during `commit` has its points re-solved
-//! from the stored state at the last trial and committed on their new owner. Because a solve
-//! is deterministic given (committed state, target), the results are bit-identical to a run
-//! without failure (diagnostics' `wall_seconds` aside). A worker that comes back, or a new
-//! address behind a DNS name, is admitted at the next load step once idle.
+//! The master keeps every assembly's committed history ([`replay`]): a committed state
+//! exported by its worker every [`PoolConfig::export_every`] steps (`Commit` with
+//! `export_state`, which costs one copy of the state over the network and in master memory:
+//! for the DEM, positions, rotations and contact history of every disc, tens of bytes per
+//! disc), and the committed increments since (step, iteration, macro deformation: a few
+//! dozen bytes per step). When a worker fails (transport error, deadline, lost assemblies),
+//! it is marked dead, its assemblies are imported on the remaining workers from the stored
+//! states and brought to the last committed step by solving and committing each recorded
+//! increment again, and the Gauss points it owed are solved again there; a worker lost
+//! during `commit` has its points re-solved at the last trial and committed on their new
+//! owner. Because a solve is deterministic given (committed state, target), the results are
+//! bit-identical to a run without failure (diagnostics' `wall_seconds` aside). A failure
+//! costs up to `export_every - 1` replayed steps of the lost worker's assemblies. A worker
+//! that comes back, or a new address behind a DNS name, is admitted at a load step once it
+//! answers and is idle: the attempt (name resolution, connection, health) runs in the
+//! background and a step waits for it at most [`PoolConfig::admit_wait`].
 //!
 //! # Balance
 //! Assemblies are placed by expected cost (disc count, then measured solve time) per core;
@@ -34,6 +39,7 @@
 
 mod balance;
 mod link;
+pub mod replay;
 
 pub use balance::Cost;
 pub use link::WorkerInfo;
@@ -44,6 +50,7 @@ use cosdem_common::micro::{AssemblyRequest, AssemblyState, MicroSnapshot};
 use cosdem_common::{GaussPointId, MacroDeformation, MicroResponse};
 use cosdem_worker::service::{Limits, MicroModel, Token, WorkerConfig, serve_duplex};
 use link::{Link, is_worker_failure};
+use replay::{History, Increment, ReplayPlan};
 use std::collections::BTreeMap;
 use std::net::SocketAddr;
 use std::time::Duration;
@@ -101,6 +108,29 @@ pub struct PoolConfig {
     pub in_process_threads: usize,
     /// TLS to remote workers (needs the `tls` feature; in-process workers never use it).
     pub tls: Option<ClientTls>,
+    /// Export the committed states to the master at every `export_every`-th commit (>= 1);
+    /// in between the master records the committed increments and a failover replays them.
+    /// 1 ships every state at every commit; larger values save that traffic and cost up to
+    /// `export_every - 1` replayed steps per lost assembly when a worker fails. Default 10
+    /// (see the README's service benchmark for the measurement behind it).
+    pub export_every: u64,
+    /// How long a load step waits for the admission of returned or new workers (name
+    /// resolution, connection, health check; each bounded by `connect_timeout`). An attempt
+    /// not finished by then goes on in the background and is taken up at a later step.
+    pub admit_wait: Duration,
+}
+
+impl PoolConfig {
+    /// Refuses values the pool cannot work with, naming the field and the value.
+    pub fn validate(&self) -> Result<(), PoolError> {
+        if self.export_every == 0 {
+            return Err(PoolError::Config("export_every = 0: must be at least 1".into()));
+        }
+        if self.max_message_bytes == 0 {
+            return Err(PoolError::Config("max_message_bytes = 0: must be positive".into()));
+        }
+        Ok(())
+    }
 }
 
 impl Default for PoolConfig {
@@ -115,6 +145,8 @@ impl Default for PoolConfig {
             runtime_threads: 2,
             in_process_threads: 0,
             tls: None,
+            export_every: 10,
+            admit_wait: Duration::from_secs(1),
         }
     }
 }
@@ -132,6 +164,10 @@ pub struct PoolStats {
     pub migrated: u64,
     /// Gauss point solves redone after a failure.
     pub resolved: u64,
+    /// Committed increments solved and committed again to restore assemblies.
+    pub replayed: u64,
+    /// Commits that also exported the committed states.
+    pub exports: u64,
 }
 
 struct Worker {
@@ -148,12 +184,13 @@ pub struct Pool {
     sources: Vec<String>,
     workers: Vec<Worker>,
     owner: BTreeMap<GaussPointId, usize>,
-    committed: BTreeMap<GaussPointId, AssemblyState>,
+    history: History,
     costs: BTreeMap<GaussPointId, Cost>,
     last: Option<(TrialId, BTreeMap<GaussPointId, MacroDeformation>)>,
     current_step: Option<u64>,
     committed_step: u64,
     stats: PoolStats,
+    admission: Option<tokio::task::JoinHandle<Vec<(SocketAddr, Link)>>>,
     _stops: Vec<tokio::sync::oneshot::Sender<()>>,
 }
 
@@ -184,19 +221,68 @@ fn refused(worker: &str, s: &Status) -> PoolError {
     PoolError::Refused { worker: worker.into(), code: s.code(), message: s.message().into() }
 }
 
-async fn resolve(source: &str) -> Vec<SocketAddr> {
-    match tokio::net::lookup_host(source).await {
-        Ok(addrs) => {
+/// The addresses `source` resolves to, within `timeout` (a name whose DNS server does not
+/// answer must not stall the run: the lookup itself goes on in a blocking thread, abandoned).
+async fn resolve(source: &str, timeout: Duration) -> Vec<SocketAddr> {
+    match tokio::time::timeout(timeout, tokio::net::lookup_host(source)).await {
+        Ok(Ok(addrs)) => {
             let mut v: Vec<_> = addrs.collect();
             v.sort();
             v.dedup();
             v
         }
-        Err(e) => {
+        Ok(Err(e)) => {
             tracing::warn!(source, error = %e, "cannot resolve worker address");
             Vec::new()
         }
+        Err(_) => {
+            tracing::warn!(source, ?timeout, "worker address not resolved in time");
+            Vec::new()
+        }
     }
+}
+
+/// Resolves every source concurrently, each within `timeout`; sorted, without duplicates.
+async fn resolve_all(sources: &[String], timeout: Duration) -> Vec<SocketAddr> {
+    let mut set = tokio::task::JoinSet::new();
+    for s in sources {
+        let s = s.clone();
+        set.spawn(async move { resolve(&s, timeout).await });
+    }
+    let mut out = Vec::new();
+    while let Some(r) = set.join_next().await {
+        out.extend(r.unwrap_or_default());
+    }
+    out.sort();
+    out.dedup();
+    out
+}
+
+/// Tries the addresses in `candidates` concurrently: those that answer the handshake, report
+/// no relaxation in flight and accept a drop of whatever they hold (one master per worker).
+/// Every step is bounded by the connect timeout.
+async fn try_admit(candidates: Vec<SocketAddr>, config: PoolConfig) -> Vec<(SocketAddr, Link)> {
+    let mut set = tokio::task::JoinSet::new();
+    for addr in candidates {
+        let c = config.clone();
+        set.spawn(async move {
+            let link = link::connect_tcp(addr, &c).await.ok()?;
+            match link.health(c.connect_timeout).await {
+                Ok((_, _, 0)) => {}
+                _ => return None,
+            }
+            link.drop_assemblies(&[], c.connect_timeout).await.ok()?;
+            Some((addr, link))
+        });
+    }
+    let mut out = Vec::new();
+    while let Some(r) = set.join_next().await {
+        if let Ok(Some(x)) = r {
+            out.push(x);
+        }
+    }
+    out.sort_by_key(|(a, _)| *a);
+    out
 }
 
 /// One worker's share of a fan-out.
@@ -204,21 +290,51 @@ type Job<T> = std::pin::Pin<Box<dyn Future<Output = Result<T, Status>> + Send>>;
 
 type Outcomes = BTreeMap<GaussPointId, Result<MicroResponse, String>>;
 
-/// Runs one job per worker concurrently; a lost task becomes an INTERNAL status.
-async fn fan_out<T: Send + 'static>(jobs: Vec<(usize, Job<T>)>) -> Vec<(usize, Result<T, Status>)> {
-    let mut set = tokio::task::JoinSet::new();
-    for (w, job) in jobs {
-        set.spawn(async move { (w, job.await) });
-    }
-    let mut out = Vec::new();
-    while let Some(r) = set.join_next().await {
-        match r {
-            Ok(x) => out.push(x),
-            Err(e) => tracing::error!("pool task lost: {e}"),
+/// Runs one job per worker concurrently, polled on the calling task (the thread blocked in
+/// `block_on`): no task is spawned per job, so a call costs no hand-off to a runtime thread
+/// and back (two thread wake-ups per call, which a loaded machine makes slow). The jobs only
+/// await the network; their results are sorted by worker.
+async fn fan_out<T>(jobs: Vec<(usize, Job<T>)>) -> Vec<(usize, Result<T, Status>)> {
+    let mut pending = jobs;
+    let mut out = Vec::with_capacity(pending.len());
+    std::future::poll_fn(|cx| {
+        let mut i = 0;
+        while i < pending.len() {
+            match pending[i].1.as_mut().poll(cx) {
+                std::task::Poll::Ready(r) => {
+                    let (w, _) = pending.swap_remove(i);
+                    out.push((w, r));
+                }
+                std::task::Poll::Pending => i += 1,
+            }
         }
-    }
+        if pending.is_empty() { std::task::Poll::Ready(()) } else { std::task::Poll::Pending }
+    })
+    .await;
     out.sort_by_key(|(w, _)| *w);
     out
+}
+
+/// Runs a replay plan on one worker: each batch solved, then committed at its trial (no
+/// export). Returns the number of increments replayed, or the first Gauss point whose replayed
+/// solve failed.
+async fn replay_on(
+    link: &Link,
+    plan: ReplayPlan,
+    solve_timeout: Duration,
+    call_timeout: Duration,
+) -> Result<Result<u64, (GaussPointId, String)>, Status> {
+    let mut replayed = 0;
+    for batch in plan.batches {
+        let ids: Vec<_> = batch.items.iter().map(|(id, _)| *id).collect();
+        replayed += ids.len() as u64;
+        let results = link.solve(batch.step, batch.iteration, batch.items, solve_timeout).await?;
+        if let Some((id, e)) = results.into_iter().find_map(|(id, r)| r.err().map(|e| (id, e))) {
+            return Ok(Err((id, e)));
+        }
+        link.commit(&ids, batch.step, batch.iteration, false, call_timeout).await?;
+    }
+    Ok(Ok(replayed))
 }
 
 impl Pool {
@@ -229,6 +345,7 @@ impl Pool {
         if addresses.is_empty() {
             return Err(PoolError::Config("no worker addresses given".into()));
         }
+        config.validate()?;
         let rt = runtime(config.runtime_threads)?;
         let handle = rt.handle().clone();
         let mut pool = Pool::empty(rt, handle, config);
@@ -238,7 +355,7 @@ impl Pool {
         h.block_on(async {
             let mut addrs = Vec::new();
             for s in &pool.sources {
-                let found = resolve(s).await;
+                let found = resolve(s, pool.config.connect_timeout).await;
                 if found.is_empty() {
                     tracing::warn!(source = %s, "no address for worker");
                 }
@@ -289,6 +406,7 @@ impl Pool {
         if n == 0 {
             return Err(PoolError::Config("in-process pool needs at least one worker".into()));
         }
+        config.validate()?;
         let rt = runtime(config.runtime_threads)?;
         let handle = rt.handle().clone();
         let mut pool = Pool::empty(rt, handle, config);
@@ -350,12 +468,13 @@ impl Pool {
             sources: Vec::new(),
             workers: Vec::new(),
             owner: BTreeMap::new(),
-            committed: BTreeMap::new(),
+            history: History::default(),
             costs: BTreeMap::new(),
             last: None,
             current_step: None,
             committed_step: 0,
             stats: PoolStats::default(),
+            admission: None,
             _stops: Vec::new(),
         }
     }
@@ -384,9 +503,15 @@ impl Pool {
         self.stats
     }
 
-    /// The master's copy of each assembly's last committed state.
+    /// The master's copy of each assembly's last exported committed state (taken every
+    /// [`PoolConfig::export_every`] commits; see [`Pool::unexported_commits`]).
     pub fn committed_states(&self) -> &BTreeMap<GaussPointId, AssemblyState> {
-        &self.committed
+        self.history.states()
+    }
+
+    /// Commits of `id` since its stored state was exported (what a failover would replay).
+    pub fn unexported_commits(&self, id: &GaussPointId) -> usize {
+        self.history.pending(id)
     }
 
     /// Builds one assembly per Gauss point from `spec`, placed by expected cost, and stores
@@ -412,7 +537,7 @@ impl Pool {
             }
         });
         self.owner.clear();
-        self.committed.clear();
+        self.history.clear();
         self.costs.clear();
         self.last = None;
     }
@@ -511,14 +636,15 @@ impl Pool {
                 self.costs.insert(i.id, Cost { discs: i.disc_count, seconds: None });
             }
             for s in states {
-                self.committed.insert(s.id, s);
+                self.history.store(s);
             }
         }
         Ok(())
     }
 
-    /// Imports the stored committed states of `ids` on live workers (by cost), retrying on
-    /// other workers when an import target fails.
+    /// Imports the stored committed states of `ids` on live workers (by cost) and replays the
+    /// increments committed since ([`replay`]), so that each assembly is back at its last
+    /// committed step with no trial; retries on other workers when a target fails.
     async fn restore(&mut self, ids: &[GaussPointId]) -> Result<(), MaterialError> {
         let mut todo: Vec<GaussPointId> = ids.to_vec();
         // Ends: every pass that leaves work marks at least one worker dead, and no worker
@@ -549,24 +675,43 @@ impl Pool {
             for (id, w) in place(&new, &alive, &mut load) {
                 by_worker.entry(w).or_default().push(id);
             }
-            let t = self.config.call_timeout;
+            let (t, ts) = (self.config.call_timeout, self.config.solve_timeout);
             let mut jobs = Vec::new();
             for (w, ids) in &by_worker {
-                let states: Vec<_> = ids.iter().map(|id| self.committed[id].clone()).collect();
+                let mut states = Vec::with_capacity(ids.len());
+                for id in ids {
+                    let s = self.history.state(id).ok_or_else(|| {
+                        MaterialError::Unavailable(format!("no stored state for {id}"))
+                    })?;
+                    states.push(s.clone());
+                }
+                let plan = self.history.plan(ids);
                 let link = self.workers[*w].link.clone();
-                let job: Job<_> = Box::pin(async move { link.import(states, t).await });
+                let job: Job<_> = Box::pin(async move {
+                    link.import(states, t).await?;
+                    replay_on(&link, plan, ts, t).await
+                });
                 jobs.push((*w, job));
             }
             todo.clear();
             for (w, r) in fan_out(jobs).await {
                 let ids = &by_worker[&w];
                 match r {
-                    Ok(()) => {
+                    Ok(Ok(replayed)) => {
                         for id in ids {
                             self.owner.insert(*id, w);
                         }
                         self.stats.restored += ids.len() as u64;
-                        tracing::info!(worker = %self.workers[w].link.name, n = ids.len(), "assemblies restored");
+                        self.stats.replayed += replayed;
+                        tracing::info!(worker = %self.workers[w].link.name, n = ids.len(), replayed, "assemblies restored");
+                    }
+                    // Deterministic solves that succeeded once cannot fail on replay: a
+                    // model that does is not replayable, say which point.
+                    Ok(Err((id, e))) => {
+                        return Err(MaterialError::GaussPoints(vec![(
+                            id,
+                            format!("replay of a committed increment failed: {e}"),
+                        )]));
                     }
                     Err(s) if is_worker_failure(&s) || s.code() == Code::ResourceExhausted => {
                         self.mark_dead(w, &s);
@@ -722,6 +867,7 @@ impl Pool {
         let mut pending: Vec<GaussPointId> = targets.keys().copied().collect();
         // Ends: a pass that leaves work lost at least one worker (see `restore`).
         let mut rounds = 0usize;
+        let every = self.config.export_every;
         while !pending.is_empty() {
             rounds += 1;
             if rounds > self.workers.len() + 1 {
@@ -736,20 +882,38 @@ impl Pool {
             }
             let t = self.config.call_timeout;
             let jobs = by_worker
-                .into_iter()
+                .iter()
                 .map(|(w, ids)| {
-                    let link = self.workers[w].link.clone();
-                    let job: Job<_> =
-                        Box::pin(async move { link.commit(&ids, step, trial.iteration, t).await });
-                    (w, job)
+                    let link = self.workers[*w].link.clone();
+                    let ids = ids.clone();
+                    let export = self.history.export_due(&ids, every);
+                    let job: Job<_> = Box::pin(async move {
+                        link.commit(&ids, step, trial.iteration, export, t).await
+                    });
+                    (*w, job)
                 })
                 .collect();
             let mut lost = Vec::new();
             for (w, r) in fan_out(jobs).await {
                 match r {
                     Ok(states) => {
-                        for s in states {
-                            self.committed.insert(s.id, s);
+                        if !states.is_empty() {
+                            self.stats.exports += 1;
+                        }
+                        let mut exported: BTreeMap<_, _> =
+                            states.into_iter().map(|s| (s.id, s)).collect();
+                        for id in &by_worker[&w] {
+                            match exported.remove(id) {
+                                Some(s) => self.history.store(s),
+                                None => self.history.record(
+                                    *id,
+                                    Increment {
+                                        step,
+                                        iteration: trial.iteration,
+                                        target: targets[id],
+                                    },
+                                ),
+                            }
                         }
                     }
                     Err(s) if is_worker_failure(&s) => {
@@ -764,11 +928,13 @@ impl Pool {
             if lost.is_empty() {
                 break;
             }
+            // Back at their last committed step as the master knows it (those whose commit
+            // was acknowledged before their worker died are at `step` already).
             self.restore(&lost).await?;
             // Those not committed yet lost their trial with their worker: solve it again.
             let redo: BTreeMap<_, _> = lost
                 .iter()
-                .filter(|id| self.committed[id].committed_step < step)
+                .filter(|id| self.history.committed_step(id).is_some_and(|s| s < step))
                 .filter_map(|id| targets.get(id).map(|t| (*id, *t)))
                 .collect();
             let again = self.solve_all(trial, &redo).await?;
@@ -836,14 +1002,58 @@ impl Pool {
             by_dest.entry(to).or_default().push((id, from));
         }
         let t = self.config.call_timeout;
+        let mut lost = Vec::new();
+        // Fresh committed states from the current owners (exact, and no replay needed on the
+        // destination); a source that fails is restored with the others at the end.
+        let mut by_source: BTreeMap<usize, Vec<GaussPointId>> = BTreeMap::new();
+        for list in by_dest.values() {
+            for (id, from) in list {
+                by_source.entry(*from).or_default().push(*id);
+            }
+        }
+        let jobs = by_source
+            .iter()
+            .map(|(from, ids)| {
+                let link = self.workers[*from].link.clone();
+                let ids = ids.clone();
+                let job: Job<_> = Box::pin(async move { link.export(&ids, t).await });
+                (*from, job)
+            })
+            .collect();
+        for (from, r) in fan_out(jobs).await {
+            match r {
+                Ok(states) => {
+                    for s in states {
+                        self.history.store(s);
+                    }
+                }
+                Err(s) => {
+                    if is_worker_failure(&s) {
+                        self.mark_dead(from, &s);
+                        lost.extend(self.owned_by(from));
+                    } else {
+                        tracing::warn!(worker = %self.workers[from].link.name, error = %s.message(), "export for migration refused");
+                    }
+                    for list in by_dest.values_mut() {
+                        list.retain(|(_, f)| *f != from);
+                    }
+                }
+            }
+        }
+        by_dest.retain(|_, list| !list.is_empty());
         let mut jobs = Vec::new();
         for (to, list) in &by_dest {
-            let states: Vec<_> = list.iter().map(|(id, _)| self.committed[id].clone()).collect();
+            let mut states = Vec::with_capacity(list.len());
+            for (id, _) in list {
+                let s = self.history.state(id).ok_or_else(|| {
+                    MaterialError::Unavailable(format!("no stored state for {id}"))
+                })?;
+                states.push(s.clone());
+            }
             let link = self.workers[*to].link.clone();
             let job: Job<_> = Box::pin(async move { link.import(states, t).await });
             jobs.push((*to, job));
         }
-        let mut lost = Vec::new();
         let mut drops: BTreeMap<usize, Vec<GaussPointId>> = BTreeMap::new();
         for (to, r) in fan_out(jobs).await {
             match r {
@@ -872,29 +1082,42 @@ impl Pool {
         self.restore(&lost).await
     }
 
-    /// Re-resolves the worker addresses; an address with no live worker (returned or new)
-    /// is admitted if it answers the handshake and is idle, after dropping whatever it holds.
+    /// Admits returned or new workers: takes up the result of the last admission attempt if
+    /// it has finished, else (none running) starts one (re-resolving the worker addresses and
+    /// trying every address with no live worker) and waits for it at most
+    /// [`PoolConfig::admit_wait`]. An attempt still running goes on in the background.
     async fn admit(&mut self) {
         if self.sources.is_empty() {
             return;
         }
-        let mut addrs = Vec::new();
-        for s in &self.sources {
-            addrs.extend(resolve(s).await);
-        }
-        for addr in addrs {
+        let task = match self.admission.take() {
+            Some(t) => t,
+            None => {
+                let live: Vec<SocketAddr> =
+                    self.workers.iter().filter(|w| w.alive).filter_map(|w| w.addr).collect();
+                let (sources, config) = (self.sources.clone(), self.config.clone());
+                self.handle.spawn(async move {
+                    let addrs = resolve_all(&sources, config.connect_timeout).await;
+                    let candidates = addrs.into_iter().filter(|a| !live.contains(a)).collect();
+                    try_admit(candidates, config).await
+                })
+            }
+        };
+        let mut task = task;
+        let found = match tokio::time::timeout(self.config.admit_wait, &mut task).await {
+            Ok(Ok(found)) => found,
+            Ok(Err(e)) => {
+                tracing::warn!("worker admission task lost: {e}");
+                return;
+            }
+            Err(_) => {
+                tracing::debug!("worker admission still running: taken up at a later step");
+                self.admission = Some(task);
+                return;
+            }
+        };
+        for (addr, link) in found {
             if self.workers.iter().any(|w| w.alive && w.addr == Some(addr)) {
-                continue;
-            }
-            let c = &self.config;
-            let Ok(link) = link::connect_tcp(addr, c).await else {
-                continue;
-            };
-            match link.health(c.connect_timeout).await {
-                Ok((_, _, 0)) => {}
-                _ => continue,
-            }
-            if link.drop_assemblies(&[], c.connect_timeout).await.is_err() {
                 continue;
             }
             tracing::info!(%addr, "worker admitted");
