@@ -37,6 +37,8 @@
 pub mod assembly;
 /// Benchmarks of the coupling (RPC overhead, worker scaling, FE versus DEM cost): `cosdem bench`.
 pub mod bench;
+/// Checkpoints (`RUN/checkpoint.bin`), resume, and the clean stop on Ctrl-C.
+pub mod checkpoint;
 /// Reference elements: Q8/Q9 shape functions and Gauss rules.
 pub mod element;
 /// The crate's error type.
@@ -55,7 +57,12 @@ pub mod output;
 pub mod pool;
 /// Derived quantities for plots (equivalent strain, Eq. 34).
 pub mod post;
+/// One DEM assembly driven through a laboratory path (biaxial, isotropic, simple shear):
+/// `cosdem rve`, for calibrating micro parameters.
+pub mod rve;
 /// Loading, linear solves, Newton-Raphson with step cutting, step observers.
 pub mod solve;
+/// Parameter studies over whole runs: the RVE-size study (Eqs. 30-32), `cosdem study`.
+pub mod study;
 
 pub use error::{Error, Result};

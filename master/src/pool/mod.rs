@@ -517,6 +517,29 @@ impl Pool {
         Ok(())
     }
 
+    /// Places saved committed states (a checkpoint) on the live workers: the pool then holds
+    /// exactly those assemblies, committed at the saved step. Ids must not have assemblies yet.
+    async fn import_states(&mut self, states: Vec<AssemblyState>) -> Result<(), MaterialError> {
+        let mut ids = Vec::with_capacity(states.len());
+        for s in states {
+            if self.owner.contains_key(&s.id) {
+                return Err(MaterialError::Unavailable(format!(
+                    "restoring {}: the pool already holds an assembly for it",
+                    s.id
+                )));
+            }
+            self.committed_step = self.committed_step.max(s.committed_step);
+            self.costs.insert(s.id, Cost { discs: s.disc_count, seconds: None });
+            ids.push(s.id);
+            self.committed.insert(s.id, s);
+        }
+        self.last = None;
+        self.restore(&ids).await?;
+        // Not a failover: the restorations above are the resume, not a recovery.
+        self.stats.restored = self.stats.restored.saturating_sub(ids.len() as u64);
+        Ok(())
+    }
+
     /// Imports the stored committed states of `ids` on live workers (by cost), retrying on
     /// other workers when an import target fails.
     async fn restore(&mut self, ids: &[GaussPointId]) -> Result<(), MaterialError> {
@@ -898,5 +921,14 @@ impl Material for Pool {
     fn rollback(&mut self) -> Result<(), MaterialError> {
         let h = self.handle.clone();
         h.block_on(self.rollback_async())
+    }
+
+    fn committed_states(&mut self) -> Result<Option<Vec<AssemblyState>>, MaterialError> {
+        Ok(Some(self.committed.values().cloned().collect()))
+    }
+
+    fn restore_states(&mut self, states: Vec<AssemblyState>) -> Result<(), MaterialError> {
+        let h = self.handle.clone();
+        h.block_on(self.import_states(states))
     }
 }

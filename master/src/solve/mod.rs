@@ -10,5 +10,5 @@ pub use linear::LinearSolver;
 pub use loading::{
     BodyLoad, Dirichlet, EdgeLoad, EdgeLoadKind, LoadVectors, Loading, Platens, Ramp,
 };
-pub use newton::{IterationTiming, Model, RunSummary, Solver, SolverSettings};
-pub use observer::{GaussPointState, SolutionView, StepObserver, StepReport};
+pub use newton::{IterationTiming, Model, RunSummary, Solver, SolverSettings, SolverState};
+pub use observer::{GaussPointState, SolutionView, StepControl, StepObserver, StepReport};
