@@ -142,7 +142,8 @@ impl RveWriter {
             .collect();
         let refs: Vec<&str> = names.iter().map(String::as_str).collect();
         let tangent = CsvWriter::create(&dir.join("tangent.csv"), &refs)?;
-        let summary = RveSummary { peak_friction_angle: f64::NAN, ..summary };
+        let summary =
+            RveSummary { peak_friction_angle: f64::NAN, max_dilatancy_angle: f64::NAN, ..summary };
         Ok(Self { dir: dir.to_path_buf(), rows, tangent, last: None, summary, tolerance })
     }
 
@@ -180,14 +181,14 @@ impl RveWriter {
         if r.control_residual > self.tolerance {
             s.uncontrolled_steps += 1;
         }
-        if phi.is_finite() && !(phi <= s.peak_friction_angle) {
+        if phi.is_finite() && (s.peak_friction_angle.is_nan() || phi > s.peak_friction_angle) {
             s.peak_friction_angle = phi;
             s.peak_step = r.step;
             s.peak_strain = strain_of_interest(&s.path, m);
             s.peak_deviatoric_stress = s1 - s3;
             s.dilatancy_at_peak = psi;
         }
-        if psi.is_finite() && !(psi <= s.max_dilatancy_angle) {
+        if psi.is_finite() && (s.max_dilatancy_angle.is_nan() || psi > s.max_dilatancy_angle) {
             s.max_dilatancy_angle = psi;
         }
         s.final_friction_angle = phi;

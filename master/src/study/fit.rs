@@ -104,7 +104,7 @@ impl SizeLawFit {
 fn solve3(mut m: [[f64; 3]; 3], mut r: [f64; 3]) -> Option<[f64; 3]> {
     for col in 0..3 {
         let piv = (col..3).max_by(|&a, &b| m[a][col].abs().total_cmp(&m[b][col].abs()))?;
-        if !(m[piv][col].abs() > 0.0) {
+        if m[piv][col].abs() <= 0.0 || m[piv][col].is_nan() {
             return None;
         }
         m.swap(col, piv);
@@ -176,7 +176,7 @@ fn linear_part(beta: f64, s: &[f64], y: &[f64]) -> Option<[f64; 3]> {
     let (se, see) = (e.iter().sum::<f64>(), e.iter().map(|x| x * x).sum::<f64>());
     let (sy, sey) = (y.iter().sum::<f64>(), e.iter().zip(y).map(|(a, b)| a * b).sum::<f64>());
     let det = n * see - se * se;
-    if !(det.abs() > 1e-14 * n * see) {
+    if det.abs() <= 1e-14 * n * see || det.is_nan() {
         return None;
     }
     let a = (n * sey - se * sy) / det;

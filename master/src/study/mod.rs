@@ -77,7 +77,7 @@ pub struct SizeRun {
 #[serde(untagged)]
 pub enum FitOutcome {
     /// The fitted law.
-    Fitted(SizeLawFit),
+    Fitted(Box<SizeLawFit>),
     /// Why no fit.
     Failed {
         /// The reason.
@@ -228,7 +228,7 @@ fn fit_of(
     let (v, f): (Vec<f64>, Vec<f64>) =
         runs.iter().filter_map(|r| value(&r.metrics).map(|x| (r.size, x))).unzip();
     match fit_size_law(&v, &f, k, tol) {
-        Ok(fit) => FitOutcome::Fitted(fit),
+        Ok(fit) => FitOutcome::Fitted(Box::new(fit)),
         Err(e) => FitOutcome::Failed { error: e.to_string() },
     }
 }
