@@ -92,6 +92,20 @@ pub enum Error {
         /// Gauss points that failed in the last attempt (empty for a pure divergence).
         gauss_points: Vec<(GaussPointId, String)>,
     },
+    /// A DEM assembly driven alone (`cosdem rve`, the size study) failed at a step.
+    #[error("RVE test step {step}: {message}")]
+    Rve {
+        /// The load step.
+        step: u64,
+        /// What went wrong.
+        message: String,
+    },
+    /// The run was asked to stop (Ctrl-C) and stopped cleanly after this committed step.
+    #[error("interrupted after step {step}")]
+    Interrupted {
+        /// The last committed step.
+        step: u64,
+    },
     /// An observer refused a converged step (e.g. output failed).
     #[error("step observer: {0}")]
     Observer(String),

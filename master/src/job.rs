@@ -343,11 +343,19 @@ pub struct OutputSection {
     pub snapshots: Vec<[u32; 2]>,
     /// Displacements (m) at which the equivalent-strain field is plotted.
     pub field_plots_at: Vec<f64>,
+    /// Write `checkpoint.bin` every this many steps (0: only when stopped by Ctrl-C).
+    pub checkpoint_every: usize,
 }
 
 impl Default for OutputSection {
     fn default() -> Self {
-        Self { dir: None, vtk_every: 1, snapshots: Vec::new(), field_plots_at: Vec::new() }
+        Self {
+            dir: None,
+            vtk_every: 1,
+            snapshots: Vec::new(),
+            field_plots_at: Vec::new(),
+            checkpoint_every: 1,
+        }
     }
 }
 

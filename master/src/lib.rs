@@ -37,6 +37,8 @@
 pub mod assembly;
 /// Benchmarks of the coupling (RPC overhead, worker scaling, FE versus DEM cost): `cosdem bench`.
 pub mod bench;
+/// Checkpoints (`RUN/checkpoint.bin`), resume, and the clean stop on Ctrl-C.
+pub mod checkpoint;
 /// Reference elements: Q8/Q9 shape functions and Gauss rules.
 pub mod element;
 /// The crate's error type.
@@ -57,8 +59,13 @@ pub mod pool;
 pub mod post;
 /// One job run to its end into a run directory (the library side of `cosdem run`).
 pub mod run;
+/// One DEM assembly driven through a laboratory path (biaxial, isotropic, simple shear):
+/// `cosdem rve`, for calibrating micro parameters.
+pub mod rve;
 /// Loading, linear solves, Newton-Raphson with step cutting, step observers.
 pub mod solve;
+/// Parameter studies over whole runs: the RVE-size study (Eqs. 30-32), `cosdem study`.
+pub mod study;
 /// Symmetric scenes on a half or quarter mesh: the reduced rectangle and its axis conditions.
 pub mod symmetry;
 /// Speed against accuracy: the knob sweep of `cosdem bench tradeoff`.

@@ -12,7 +12,7 @@ use crate::output::run_dir::{RunSettings, RunWriter, Summary};
 use crate::pool::{Pool, PoolConfig};
 use crate::solve::Solver;
 use cosdem_common::GaussPointId;
-use cosdem_common::micro::{AssemblyRequest, BoundaryKind};
+use cosdem_common::micro::{AssemblyRequest, AssemblyState, BoundaryKind};
 use cosdem_worker::service::Dem;
 use std::path::Path;
 
@@ -74,10 +74,13 @@ pub fn gauss_point_ids(solver: &Solver) -> Vec<GaussPointId> {
 /// What answers at the Gauss points, and how many workers serve it (0 for an analytical
 /// material). A DEM job gets a pool (remote workers when `workers.addresses` is non-empty,
 /// else the job's `[workers] in_process` in-process workers) with one assembly per point.
+///
+/// `saved` (a resume) places those committed states instead of building new assemblies.
 pub fn material_for(
     job: &Job,
     workers: &WorkerChoice,
     ids: &[GaussPointId],
+    saved: Option<Vec<AssemblyState>>,
 ) -> Result<(Box<dyn Material>, usize), RunError> {
     match &job.material {
         MaterialSection::Elastic { .. } => {
@@ -102,7 +105,11 @@ pub fn material_for(
                 boundary: BoundaryKind::Unspecified,
                 disc_count_hint: 0,
             };
-            pool.create_assemblies(ids, &request)?;
+            match saved {
+                // Resume: the assemblies as committed at the checkpoint.
+                Some(states) => pool.restore_states(states).map_err(crate::Error::from)?,
+                None => pool.create_assemblies(ids, &request)?,
+            }
             let n = pool.live_workers();
             Ok((Box::new(pool), n))
         }
@@ -122,7 +129,7 @@ pub fn run_job(
     let mut writer = RunWriter::create(dir, run_settings(job))?;
     let mut solver = Solver::new(job.model()?, job.solver_settings()?)?;
     let ids = gauss_point_ids(&solver);
-    let (mut material, n) = material_for(job, workers, &ids)?;
+    let (mut material, n) = material_for(job, workers, &ids, None)?;
     writer.set_workers(n);
     let outcome = solver.run(material.as_mut(), &mut writer);
     writer.finish(outcome.as_ref().map(|_| ()).map_err(|e| e.to_string()))?;

@@ -1,9 +1,15 @@
 //! `cosdem`: run a two-scale job file.
 //!
 //! ```text
-//! cosdem run JOB.toml [--workers LIST] [--out DIR] [--token-file FILE]
+//! cosdem run JOB.toml [--workers LIST] [--out DIR] [--token-file FILE] [--resume]
+//! cosdem rve JOB.toml --path biaxial|isotropic|simple-shear|FILE [--steps N] [--increment X]
+//!     [--pressure P] [--out DIR]
+//! cosdem study rve-size JOB.toml --sizes V1,V2,... [--radius R] [--out DIR]
 //! cosdem bench overhead|scaling|fe|all [OPTIONS]
 //! ```
+//! `run` checkpoints into `RUN/checkpoint.bin` (every `[output] checkpoint_every` steps);
+//! Ctrl-C stops after the current step (checkpoint written, status `interrupted`, exit code
+//! 130) and `--resume` continues from the checkpoint.
 //! `bench` prints the coupling benchmarks of `cosdem_master::bench` (build with `--release`;
 //! the TCP runs start the `cosdem-worker` binary found next to `cosdem`).
 //! With no workers given, the DEM assemblies are solved by in-process workers (no servers to
@@ -12,10 +18,11 @@
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use cosdem_master::bench::{Workload, fe_versus_dem, overhead, rpc_floor, scaling, worker_binary};
-use cosdem_master::job::Job;
+use cosdem_master::job::{Job, MaterialSection};
 use cosdem_master::output::run_dir::RunWriter;
 use cosdem_master::pool::PoolConfig;
 use cosdem_master::run::{WorkerChoice, gauss_point_ids, material_for, run_settings};
+use cosdem_master::checkpoint::{self, Checkpoint, Checkpointer};
 use cosdem_master::solve::{SolutionView, Solver, StepObserver, StepReport};
 use cosdem_worker::service::Token;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -33,6 +40,13 @@ struct Cli {
 enum Command {
     /// Run a job file.
     Run(RunArgs),
+    /// One DEM assembly of the job driven through a laboratory path (calibration).
+    Rve(RveArgs),
+    /// Parameter studies over whole runs.
+    Study {
+        #[command(subcommand)]
+        what: StudyWhat,
+    },
     /// Benchmarks of the coupling (see `cosdem_master::bench`): printed figures.
     Bench {
         #[command(subcommand)]
@@ -233,6 +247,209 @@ struct RunArgs {
     /// No progress bar (logs only).
     #[arg(long)]
     quiet: bool,
+    /// Continue from the run directory's checkpoint.bin.
+    #[arg(long)]
+    resume: bool,
+}
+
+#[derive(Subcommand)]
+enum StudyWhat {
+    /// Scene A once per assembly size V; fit of Eqs. 30-32 (study.csv, study.json).
+    RveSize(RveSizeArgs),
+}
+
+#[derive(clap::Args)]
+struct RveSizeArgs {
+    /// The job file (TOML) with `[material] kind = "dem"`.
+    job: PathBuf,
+    /// Assembly sizes V (m^2): the packing side becomes sqrt(V).
+    #[arg(long, value_delimiter = ',', required = true)]
+    sizes: Vec<f64>,
+    /// Disc radius (m) replacing the job's (hexagonal packings).
+    #[arg(long)]
+    radius: Option<f64>,
+    /// V^cr is where a property comes within this fraction of its representative value.
+    #[arg(long, default_value_t = 0.01)]
+    tolerance: f64,
+    /// Runs side by side (0 = one per core); each run is single-threaded.
+    #[arg(long, default_value_t = 0)]
+    threads: usize,
+    /// Output directory (default `runs/<job stem>-rve-size`).
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+#[derive(clap::Args)]
+struct RveArgs {
+    /// The job file (TOML) with `[material] kind = "dem"`.
+    job: PathBuf,
+    /// `biaxial`, `isotropic`, `simple-shear`, or a CSV file of prescribed F, w, kappa.
+    #[arg(long)]
+    path: String,
+    /// Load steps after the initial state (tables: one per row).
+    #[arg(long, default_value_t = 100)]
+    steps: usize,
+    /// Strain (or shear) increment per step.
+    #[arg(long, default_value_t = 1e-3)]
+    increment: f64,
+    /// Confining pressure (biaxial) or vertical stress (simple shear), Pa, compression
+    /// positive. Default: the job's largest `[[loading.pressure]]`, else the random packing's
+    /// confining stress, else 100 kPa (biaxial) / none (simple shear).
+    #[arg(long)]
+    pressure: Option<f64>,
+    /// Stress-control tolerance, relative to the pressure.
+    #[arg(long, default_value_t = 1e-3)]
+    tolerance: f64,
+    /// Output directory (default `runs/<job stem>-rve-<path>`).
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+fn stem(job: &Path) -> String {
+    job.file_stem().map_or("run".into(), |s| s.to_string_lossy().into_owned())
+}
+
+fn rve(args: RveArgs) -> Result<()> {
+    use cosdem_master::rve::{RvePath, RveSettings, drive, report, table};
+    let job = Job::load(&args.job)?;
+    let MaterialSection::Dem { assembly } = &job.material else {
+        anyhow::bail!("{}: `cosdem rve` needs [material] kind = \"dem\"", args.job.display());
+    };
+    let path = match args.path.as_str() {
+        "biaxial" => RvePath::Biaxial,
+        "isotropic" => RvePath::Isotropic,
+        "simple-shear" => RvePath::SimpleShear,
+        file => RvePath::Table(table::read(Path::new(file))?),
+    };
+    let from_job = job.loading.pressure.iter().map(|p| p.value).fold(0.0, f64::max);
+    let from_packing = match &assembly.packing {
+        cosdem_worker::PackingSpec::Random { confining_stress, .. } => *confining_stress,
+        _ => 0.0,
+    };
+    let pressure = args.pressure.unwrap_or(match (&path, from_job, from_packing) {
+        (_, p, _) if p > 0.0 => p,
+        (_, _, p) if p > 0.0 => p,
+        (RvePath::Biaxial, _, _) => 1e5,
+        _ => 0.0,
+    });
+    let settings = RveSettings {
+        path,
+        steps: args.steps,
+        increment: args.increment,
+        pressure,
+        tolerance: args.tolerance,
+        ..RveSettings::default()
+    };
+    settings.validate()?;
+    let dir = args.out.clone().unwrap_or_else(|| {
+        Path::new("runs").join(format!("{}-rve-{}", stem(&args.job), settings.path.name()))
+    });
+    let t0 = Instant::now();
+    let mut a = cosdem_worker::Assembly::new(assembly)?;
+    let summary = report::RveSummary {
+        path: settings.path.name().into(),
+        discs: a.disc_count(),
+        area: a.area(),
+        ..Default::default()
+    };
+    let mut writer = report::RveWriter::create(&dir, summary, settings.tolerance)?;
+    println!(
+        "{} test: {} discs, V = {:.4e} m^2, p = {:.4e} Pa, {} steps of {:.1e} -> {}",
+        settings.path.name(),
+        a.disc_count(),
+        a.area(),
+        settings.pressure,
+        settings.steps,
+        settings.increment,
+        dir.display()
+    );
+    let outcome = drive(&mut a, &settings, &mut |r| {
+        writer.write(r).map_err(|e| cosdem_master::Error::Observer(e.to_string()))
+    });
+    writer.finish(t0.elapsed().as_secs_f64())?;
+    let s = writer.summary();
+    println!(
+        "peak friction angle {:.2} deg at step {} (strain {:.4e}, q = {:.4e} Pa), dilatancy at peak {:.2} deg, max {:.2} deg; final friction angle {:.2} deg, volumetric strain {:.4e}; {} DEM steps, {:.1} s",
+        s.peak_friction_angle,
+        s.peak_step,
+        s.peak_strain,
+        s.peak_deviatoric_stress,
+        s.dilatancy_at_peak,
+        s.max_dilatancy_angle,
+        s.final_friction_angle,
+        s.final_volumetric_strain,
+        s.dem_steps,
+        s.wall_seconds
+    );
+    if s.uncontrolled_steps > 0 {
+        println!(
+            "warning: {} step(s) missed the stress-control tolerance (column control_residual)",
+            s.uncontrolled_steps
+        );
+    }
+    outcome.with_context(|| format!("test stopped; finished steps are in {}", dir.display()))?;
+    Ok(())
+}
+
+fn study(what: StudyWhat) -> Result<()> {
+    use cosdem_master::study::{FitOutcome, RveSizeSettings, rve_size};
+    let StudyWhat::RveSize(a) = what;
+    let job = Job::load(&a.job)?;
+    let dir = a
+        .out
+        .clone()
+        .unwrap_or_else(|| Path::new("runs").join(format!("{}-rve-size", stem(&a.job))));
+    let settings = RveSizeSettings {
+        sizes: a.sizes.clone(),
+        radius: a.radius,
+        tolerance: a.tolerance,
+        threads: a.threads,
+        ..RveSizeSettings::default()
+    };
+    println!("RVE-size study: {} sizes -> {}", settings.sizes.len(), dir.display());
+    let study = rve_size(&job, &settings, &dir)?;
+    let opt = |x: Option<f64>| x.map_or("-".to_string(), |v| format!("{v:.4e}"));
+    println!(
+        "{:>10} {:>6} {:>6} {:>11} {:>11} {:>11} {:>11} {:>8}  status",
+        "V (m^2)", "discs", "steps", "F_u (N)", "F_res (N)", "E (N/m)", "E50 (N/m)", "wall (s)"
+    );
+    for r in &study.runs {
+        let m = &r.metrics;
+        println!(
+            "{:>10.4e} {:>6} {:>6} {:>11.4e} {:>11} {:>11} {:>11} {:>8.1}  {}",
+            r.size,
+            r.discs,
+            r.steps,
+            m.peak_load,
+            opt(m.residual_load),
+            opt(m.stiffness),
+            opt(m.stiffness_50),
+            r.wall_seconds,
+            r.status
+        );
+    }
+    let ci = |e: &cosdem_master::study::fit::Estimate| match (e.low, e.high) {
+        (Some(l), Some(h)) => format!("{:.4e} [{l:.4e}, {h:.4e}]", e.value),
+        _ => format!("{:.4e}", e.value),
+    };
+    for (name, fit) in [
+        ("F_u (Eq. 30)", &study.peak_load),
+        ("F_res (Eq. 31)", &study.residual_load),
+        ("E (Eq. 32)", &study.stiffness),
+        ("E50 (Eq. 32)", &study.stiffness_50),
+    ] {
+        match fit {
+            FitOutcome::Fitted(f) => println!(
+                "{name}: a = {}, b* = {}, representative = {}, V^cr = {} m^2",
+                ci(&f.a),
+                ci(&f.b_star),
+                ci(&f.representative),
+                f.v_cr.as_ref().map_or("undefined (no plateau)".into(), ci)
+            ),
+            FitOutcome::Failed { error } => println!("{name}: no fit: {error}"),
+        }
+    }
+    Ok(())
 }
 
 /// Forwards every step to the run writer and moves the progress bar.
@@ -280,8 +497,13 @@ fn run_dir(args: &RunArgs, job: &Job) -> PathBuf {
     Path::new("runs").join(stem)
 }
 
-fn init_logging(dir: &Path) -> Result<()> {
-    let file = std::fs::File::create(dir.join("cosdem.log"))
+fn init_logging(dir: &Path, append: bool) -> Result<()> {
+    let file = std::fs::OpenOptions::new()
+        .create(true)
+        .write(true)
+        .append(append)
+        .truncate(!append)
+        .open(dir.join("cosdem.log"))
         .with_context(|| format!("creating {}", dir.join("cosdem.log").display()))?;
     tracing_subscriber::fmt()
         .with_env_filter(
@@ -305,11 +527,29 @@ fn run(args: RunArgs) -> Result<()> {
     let job = Job::load(&args.job)?;
     let dir = run_dir(&args, &job);
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
-    init_logging(&dir)?;
-    let mut writer = RunWriter::create(&dir, run_settings(&job))?;
+    init_logging(&dir, args.resume)?;
+    let checkpoint = if args.resume {
+        let path = dir.join(checkpoint::FILE);
+        let c = Checkpoint::read(&path)?;
+        c.check_job(&job, &path)?;
+        tracing::info!(step = c.solver.step, "resuming from {}", path.display());
+        Some(c)
+    } else {
+        None
+    };
+    let mut writer = match &checkpoint {
+        Some(c) => RunWriter::resume(&dir, run_settings(&job), c.solver.step)?,
+        None => RunWriter::create(&dir, run_settings(&job))?,
+    };
     let mut solver = Solver::new(job.model()?, job.solver_settings()?)?;
     let ids = gauss_point_ids(&solver);
-    let (mut material, workers) = material_for(&job, &worker_choice(&job, &args)?, &ids)?;
+    let saved = checkpoint.as_ref().map(Checkpoint::assembly_states);
+    let (mut material, workers) =
+        material_for(&job, &worker_choice(&job, &args)?, &ids, saved)?;
+    if let Some(c) = checkpoint {
+        solver.restore(c.solver)?;
+    }
+    let stop = checkpoint::ctrl_c_flag().context("installing the Ctrl-C handler")?;
     writer.set_workers(workers);
     let bar = if args.quiet { ProgressBar::hidden() } else { ProgressBar::new(1000) };
     bar.set_style(
@@ -319,12 +559,18 @@ fn run(args: RunArgs) -> Result<()> {
     let span = tracing::info_span!("run", job = %args.job.display());
     let _enter = span.enter();
     let outcome = {
-        let mut progress =
-            Progress { writer: &mut writer, bar: bar.clone(), started: Instant::now() };
-        solver.run(material.as_mut(), &mut progress)
+        let progress = Progress { writer: &mut writer, bar: bar.clone(), started: Instant::now() };
+        let every = job.output.checkpoint_every;
+        let mut observer = Checkpointer::new(progress, &dir, every, &job, stop);
+        solver.run(material.as_mut(), &mut observer)
     };
     bar.finish_and_clear();
-    writer.finish(outcome.as_ref().map(|_| ()).map_err(|e| e.to_string()))?;
+    let interrupted = matches!(outcome, Err(cosdem_master::Error::Interrupted { .. }));
+    if interrupted {
+        writer.finish_interrupted()?;
+    } else {
+        writer.finish(outcome.as_ref().map(|_| ()).map_err(|e| e.to_string()))?;
+    }
     let s = writer.summary();
     let m = &s.metrics;
     println!(
@@ -345,6 +591,14 @@ fn run(args: RunArgs) -> Result<()> {
             s.skipped_relaxations, s.linear_answers, s.max_error_bound
         );
     }
+    if interrupted {
+        anyhow::bail!(
+            "interrupted after step {}: finished steps and the checkpoint are in {}; continue with `cosdem run {} --resume`",
+            s.steps,
+            dir.display(),
+            args.job.display()
+        );
+    }
     outcome.with_context(|| format!("run stopped; finished steps are in {}", dir.display()))?;
     Ok(())
 }
@@ -353,6 +607,8 @@ fn main() -> Result<()> {
     let cli = Cli::parse();
     match cli.command {
         Command::Run(args) => run(args),
+        Command::Rve(args) => rve(args),
+        Command::Study { what } => study(what),
         Command::Bench { what } => bench(what),
     }
 }

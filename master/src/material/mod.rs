@@ -4,12 +4,15 @@
 //! iteration with every Gauss point's trial kinematics, then `commit` or `rollback`. An
 //! analytical material and the DEM-backed worker pool are both implementations.
 
+use cosdem_common::micro::AssemblyState;
 use cosdem_common::{GaussPointId, MacroDeformation, MicroResponse};
 
+mod direct;
 mod elastic;
 mod failing;
 mod softening;
 
+pub use direct::DirectDem;
 pub use elastic::ElasticCosserat;
 pub use failing::FailureInjector;
 pub use softening::SofteningElastic;
@@ -75,5 +78,18 @@ pub trait Material: Send {
     /// True when the tangent is symmetric (the solver may then use Cholesky).
     fn is_symmetric(&self) -> bool {
         false
+    }
+
+    /// The committed state of every Gauss point, for a checkpoint; `None` for a material
+    /// without state (analytical laws).
+    fn committed_states(&mut self) -> Result<Option<Vec<AssemblyState>>, MaterialError> {
+        Ok(None)
+    }
+
+    /// Puts back committed states saved by [`Material::committed_states`] (resume from a
+    /// checkpoint). Stateless materials ignore them.
+    fn restore_states(&mut self, states: Vec<AssemblyState>) -> Result<(), MaterialError> {
+        let _ = states;
+        Ok(())
     }
 }

@@ -151,6 +151,102 @@ impl RunWriter {
         Ok(w)
     }
 
+    /// Continues the run directory of a run resumed at committed step `step` (from its
+    /// checkpoint): `curve.csv` keeps its rows up to `step` (later rows, written after the
+    /// checkpoint, are dropped; new rows are appended), the `.pvd` series keep their datasets
+    /// up to that step's displacement, and the summary's totals are rebuilt from the kept rows.
+    pub fn resume(dir: &Path, settings: RunSettings, step: u64) -> Result<Self> {
+        let path = dir.join("curve.csv");
+        let text = std::fs::read_to_string(&path).map_err(super::io_err(&path, "read"))?;
+        let mut kept = String::new();
+        let mut rows: Vec<Vec<f64>> = Vec::new();
+        for (i, line) in text.split_inclusive('\n').enumerate() {
+            if i == 0 {
+                kept.push_str(line);
+                continue;
+            }
+            if !line.ends_with('\n') {
+                break; // a row cut short by a kill
+            }
+            let values: Vec<f64> =
+                line.trim_end().split(',').filter_map(|v| v.parse().ok()).collect();
+            if values.len() != CURVE_COLUMNS.len() {
+                return Err(super::invalid(
+                    &path,
+                    format!("line {}: {line:?} is not a curve row", i + 1),
+                ));
+            }
+            if values[0] > step as f64 {
+                break;
+            }
+            kept.push_str(line);
+            rows.push(values);
+        }
+        if rows.len() as u64 != step {
+            return Err(super::invalid(
+                &path,
+                format!(
+                    "{} rows up to step {step}: the curve does not match the checkpoint",
+                    rows.len()
+                ),
+            ));
+        }
+        write_atomic(&path, kept.as_bytes())?;
+        let csv = CsvWriter::resume(&path, &CURVE_COLUMNS)?;
+        let displacement = rows.last().map_or(0.0, |r| r[2]);
+        let (fields, gauss) = if settings.vtk_every > 0 {
+            std::fs::create_dir_all(dir.join("vtk"))
+                .map_err(super::io_err(dir, "create vtk/ in"))?;
+            let mut f = PvdWriter::resume(&dir.join("fields.pvd"))?;
+            let mut g = PvdWriter::resume(&dir.join("gauss.pvd"))?;
+            f.truncate_after(displacement)?;
+            g.truncate_after(displacement)?;
+            (Some(f), Some(g))
+        } else {
+            (None, None)
+        };
+        // Wall time of the sessions before this one, if the old summary says.
+        // The counters the curve does not hold come from the old summary (a session stopped
+        // after its last checkpoint counts a few answers twice: they are diagnostics).
+        let old = std::fs::read_to_string(dir.join("summary.json"))
+            .ok()
+            .and_then(|t| serde_json::from_str::<serde_json::Value>(&t).ok())
+            .unwrap_or_default();
+        let before = old["wall_seconds"].as_f64().unwrap_or(0.0);
+        let count = |key: &str| old[key].as_u64().unwrap_or(0);
+        let curve: Vec<(f64, f64)> = rows.iter().map(|r| (r[2], r[3])).collect();
+        let summary = Summary {
+            title: settings.title.clone(),
+            status: "running".into(),
+            steps: step,
+            displacement,
+            metrics: CurveMetrics::from_curve(&curve, settings.linear_range),
+            dem_steps: rows.iter().map(|r| r[6] as u64).sum(),
+            capped_relaxations: rows.iter().map(|r| r[7] as u64).sum(),
+            cuts: rows.iter().map(|r| r[5] as u64).sum(),
+            skipped_relaxations: count("skipped_relaxations"),
+            linear_answers: count("linear_answers"),
+            max_error_bound: old["max_error_bound"].as_f64().unwrap_or(0.0),
+            tolerated_steps: count("tolerated_steps"),
+            wall_seconds: before,
+            workers: 0,
+        };
+        let started = Instant::now()
+            .checked_sub(std::time::Duration::from_secs_f64(before.max(0.0)))
+            .unwrap_or_else(Instant::now);
+        let mut w =
+            Self { dir: dir.to_path_buf(), settings, csv, fields, gauss, curve, summary, started };
+        w.write_summary()?;
+        Ok(w)
+    }
+
+    /// Marks the run interrupted (stopped cleanly; resume with `--resume`) and writes the
+    /// summary.
+    pub fn finish_interrupted(&mut self) -> Result<()> {
+        self.summary.status = "interrupted".into();
+        self.write_summary()
+    }
+
     /// The run directory.
     pub fn dir(&self) -> &Path {
         &self.dir

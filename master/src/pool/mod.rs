@@ -642,6 +642,60 @@ impl Pool {
         Ok(())
     }
 
+    /// Exports every assembly's committed state from its owner now (a checkpoint needs the
+    /// states of the last committed step, not those of the last periodic export), storing
+    /// them as the failover copies. A worker that fails here is an error: the checkpoint is
+    /// not written and the next step's failover handles the loss.
+    async fn export_all(&mut self) -> Result<(), MaterialError> {
+        let t = self.config.call_timeout;
+        let jobs = (0..self.workers.len())
+            .filter(|w| self.workers[*w].alive)
+            .filter_map(|w| {
+                let ids = self.owned_by(w);
+                if ids.is_empty() {
+                    return None;
+                }
+                let link = self.workers[w].link.clone();
+                let job: Job<_> = Box::pin(async move { link.export(&ids, t).await });
+                Some((w, job))
+            })
+            .collect();
+        for (w, r) in fan_out(jobs).await {
+            match r {
+                Ok(states) => {
+                    for s in states {
+                        self.history.store(s);
+                    }
+                }
+                Err(s) => return Err(self.unavailable(w, "export for a checkpoint", &s)),
+            }
+        }
+        Ok(())
+    }
+
+    /// Places saved committed states (a checkpoint) on the live workers: the pool then holds
+    /// exactly those assemblies, committed at the saved step. Ids must not have assemblies yet.
+    async fn import_states(&mut self, states: Vec<AssemblyState>) -> Result<(), MaterialError> {
+        let mut ids = Vec::with_capacity(states.len());
+        for s in states {
+            if self.owner.contains_key(&s.id) {
+                return Err(MaterialError::Unavailable(format!(
+                    "restoring {}: the pool already holds an assembly for it",
+                    s.id
+                )));
+            }
+            self.committed_step = self.committed_step.max(s.committed_step);
+            self.costs.insert(s.id, Cost { discs: s.disc_count, seconds: None });
+            ids.push(s.id);
+            self.history.store(s);
+        }
+        self.last = None;
+        self.restore(&ids).await?;
+        // Not a failover: the restorations above are the resume, not a recovery.
+        self.stats.restored = self.stats.restored.saturating_sub(ids.len() as u64);
+        Ok(())
+    }
+
     /// Imports the stored committed states of `ids` on live workers (by cost) and replays the
     /// increments committed since ([`replay`]), so that each assembly is back at its last
     /// committed step with no trial; retries on other workers when a target fails.
@@ -1151,5 +1205,16 @@ impl Material for Pool {
     fn rollback(&mut self) -> Result<(), MaterialError> {
         let h = self.handle.clone();
         h.block_on(self.rollback_async())
+    }
+
+    fn committed_states(&mut self) -> Result<Option<Vec<AssemblyState>>, MaterialError> {
+        let h = self.handle.clone();
+        h.block_on(self.export_all())?;
+        Ok(Some(self.history.states().values().cloned().collect()))
+    }
+
+    fn restore_states(&mut self, states: Vec<AssemblyState>) -> Result<(), MaterialError> {
+        let h = self.handle.clone();
+        h.block_on(self.import_states(states))
     }
 }

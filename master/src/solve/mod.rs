@@ -12,6 +12,6 @@ pub use loading::{
 };
 pub use newton::{
     IterationTiming, MAX_LOAD_STEPS, MIN_INCREMENT_FRACTION, Model, RunSummary, Solver,
-    SolverSettings,
+    SolverSettings, SolverState,
 };
-pub use observer::{GaussPointState, SolutionView, StepObserver, StepReport};
+pub use observer::{GaussPointState, SolutionView, StepControl, StepObserver, StepReport};

@@ -8,7 +8,7 @@
 
 use super::linear::LinearSolver;
 use super::loading::{LoadVectors, Loading};
-use super::observer::{GaussPointState, SolutionView, StepObserver, StepReport};
+use super::observer::{GaussPointState, SolutionView, StepControl, StepObserver, StepReport};
 use crate::assembly::{Assembled, CosseratOperator, DofMap, Field, GaussData, Pattern};
 use crate::element::{ElementKind, QuadratureRule};
 use crate::error::{Error, Result};
@@ -149,6 +149,25 @@ impl SolverSettings {
     }
 }
 
+/// The evolving state of a [`Solver`] at a converged step (see [`Solver::state`]).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SolverState {
+    /// Nodal dofs (all dofs).
+    pub u: Vec<f64>,
+    /// Converged load factor.
+    pub lambda: f64,
+    /// Converged steps.
+    pub step: u64,
+    /// Increment of the next attempt.
+    pub increment: f64,
+    /// Responses at the converged state (the next predictor's tangent).
+    pub committed: Option<Vec<MicroResponse>>,
+    /// Gauss-point states.
+    pub gauss_points: Vec<GaussPointState>,
+    /// Reactions of the named node sets.
+    pub reactions: BTreeMap<String, [f64; 3]>,
+}
+
 /// The whole run's step reports.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct RunSummary {
@@ -207,6 +226,8 @@ pub struct Solver {
     lambda: f64,
     /// Converged steps so far.
     step: u64,
+    /// Load-factor increment of the next attempt (grows after easy steps, halves on cuts).
+    increment: f64,
     /// Responses at the converged state (the next predictor's tangent), if known.
     committed: Option<Vec<MicroResponse>>,
     /// Gauss-point states at the converged state.
@@ -251,6 +272,7 @@ impl Solver {
             gauss_points = gauss.len(),
             "system set up"
         );
+        let first_increment = 1.0 / settings.steps as f64;
         Ok(Self {
             operator: CosseratOperator { field: model.field },
             values: vec![0.0; pattern.nnz()],
@@ -264,6 +286,7 @@ impl Solver {
             loads,
             lambda: 0.0,
             step: 0,
+            increment: first_increment,
             committed: None,
             states,
             reactions: BTreeMap::new(),
@@ -310,7 +333,70 @@ impl Solver {
         &self.reactions
     }
 
+    /// Everything that evolves from step to step, at the last converged step: what a
+    /// checkpoint saves (with the material's committed states).
+    pub fn state(&self) -> SolverState {
+        SolverState {
+            u: self.u.clone(),
+            lambda: self.lambda,
+            step: self.step,
+            increment: self.increment,
+            committed: self.committed.clone(),
+            gauss_points: self.states.clone(),
+            reactions: self.reactions.clone(),
+        }
+    }
+
+    /// Continues from a saved [`SolverState`] of a solver built from the same model and
+    /// settings: the following steps are bit-identical to those of the uninterrupted run
+    /// (given the material's committed states of the same step).
+    pub fn restore(&mut self, state: SolverState) -> Result<()> {
+        let bad = |field: &'static str, value: usize, expected: usize| Error::InvalidSetting {
+            field,
+            value: value.to_string(),
+            reason: format!("the saved state does not fit this model: expected {expected}"),
+        };
+        if state.u.len() != self.u.len() {
+            return Err(bad("checkpoint.u", state.u.len(), self.u.len()));
+        }
+        if state.gauss_points.len() != self.states.len() {
+            return Err(bad(
+                "checkpoint.gauss_points",
+                state.gauss_points.len(),
+                self.states.len(),
+            ));
+        }
+        if let Some(c) = &state.committed
+            && c.len() != self.states.len()
+        {
+            return Err(bad("checkpoint.committed", c.len(), self.states.len()));
+        }
+        if !(state.increment > 0.0 && state.lambda >= 0.0) {
+            return Err(Error::InvalidSetting {
+                field: "checkpoint.increment",
+                value: state.increment.to_string(),
+                reason: "must be > 0".into(),
+            });
+        }
+        self.u = state.u;
+        self.lambda = state.lambda;
+        self.step = state.step;
+        self.increment = state.increment;
+        self.committed = state.committed;
+        self.states = state.gauss_points;
+        self.reactions = state.reactions;
+        Ok(())
+    }
+
+    /// Converged steps so far.
+    pub fn step(&self) -> u64 {
+        self.step
+    }
+
     /// Runs all load steps to `lambda = 1`, calling `observer` after each converged step.
+    ///
+    /// After each step, [`StepObserver::after_step`] may ask to stop: the run then ends with
+    /// [`Error::Interrupted`] (the step is committed and observed).
     pub fn run(
         &mut self,
         material: &mut dyn Material,
@@ -318,7 +404,6 @@ impl Solver {
     ) -> Result<RunSummary> {
         let nominal = 1.0 / self.settings.steps as f64;
         let min_increment = nominal * self.settings.min_increment_fraction;
-        let mut increment = nominal;
         let mut summary = RunSummary::default();
         let mut cuts = 0u32;
         let mut iteration = 0u32; // TrialId.iteration: keeps counting across cuts
@@ -326,16 +411,16 @@ impl Solver {
         // increment, checked below) or cuts the increment, and at most log2(1 /
         // min_increment_fraction) + 1 cuts in a row end the run with StepTooSmall.
         while self.lambda < 1.0 - 1e-12 {
-            let target = (self.lambda + increment).min(1.0);
+            let target = (self.lambda + self.increment).min(1.0);
             let step = self.step + 1;
             if target <= self.lambda {
                 return Err(Error::InvalidSetting {
                     field: "min_increment_fraction",
                     value: self.settings.min_increment_fraction.to_string(),
                     reason: format!(
-                        "the increment {increment:e} no longer moves the load factor \
+                        "the increment {:e} no longer moves the load factor \
                          {:.17}: raise it",
-                        self.lambda
+                        self.increment, self.lambda
                     ),
                 });
             }
@@ -364,12 +449,15 @@ impl Solver {
                     } else {
                         tracing::info!(iterations, cuts, "step converged");
                     }
-                    observer.on_step(&report, &self.solution())?;
-                    summary.steps.push(report);
                     cuts = 0;
                     iteration = 0;
                     if iterations <= self.settings.easy_iterations {
-                        increment = (done * self.settings.growth).min(nominal);
+                        self.increment = (done * self.settings.growth).min(nominal);
+                    }
+                    observer.on_step(&report, &self.solution())?;
+                    summary.steps.push(report);
+                    if observer.after_step(self, material)? == StepControl::Stop {
+                        return Err(Error::Interrupted { step: self.step });
                     }
                 }
                 Attempt::Failed(failure) => {
@@ -381,8 +469,8 @@ impl Solver {
                         "cutting the step"
                     );
                     cuts += 1;
-                    increment = 0.5 * tried;
-                    if increment < min_increment * (1.0 - 1e-9) {
+                    self.increment = 0.5 * tried;
+                    if self.increment < min_increment * (1.0 - 1e-9) {
                         return Err(Error::StepTooSmall {
                             step,
                             load_factor: self.lambda,

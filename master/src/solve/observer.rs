@@ -2,7 +2,9 @@
 
 use crate::assembly::Field;
 use crate::error::Result;
+use crate::material::Material;
 use crate::mesh::Mesh;
+use crate::solve::Solver;
 use cosdem_common::{GaussPointId, MicroDiagnostics};
 use std::collections::BTreeMap;
 
@@ -33,7 +35,7 @@ pub struct StepReport {
 }
 
 /// State of one Gauss point at a converged step.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct GaussPointState {
     /// Which point.
     pub id: GaussPointId,
@@ -76,10 +78,26 @@ impl SolutionView<'_> {
     }
 }
 
+/// What the solver does after a step has been observed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StepControl {
+    /// Go on with the next step.
+    Continue,
+    /// End the run now ([`crate::Error::Interrupted`]); the step is committed and observed.
+    Stop,
+}
+
 /// Called after every converged (committed) step, e.g. to write output as the run goes.
 pub trait StepObserver {
     /// Sees the step; an error stops the run.
     fn on_step(&mut self, report: &StepReport, state: &SolutionView<'_>) -> Result<()>;
+
+    /// Called after [`StepObserver::on_step`] with the solver and the material at the
+    /// committed step (what a checkpoint saves); may stop the run cleanly.
+    fn after_step(&mut self, solver: &Solver, material: &mut dyn Material) -> Result<StepControl> {
+        let _ = (solver, material);
+        Ok(StepControl::Continue)
+    }
 }
 
 /// Ignores every step.

@@ -1,0 +1,324 @@
+//! Parameter studies over whole two-scale runs: `cosdem study rve-size` (THEORY.md section 4,
+//! the paper's Figs. 3-5).
+//!
+//! The RVE-size study runs the job (scene A) once per assembly size `V`, with the packing's
+//! `side = sqrt(V)` (and optionally another disc radius), reads F_u, F_res, E and E50 off
+//! each load-displacement curve ([`CurveMetrics`]) and fits the size law of Eqs. 30-32 to
+//! each property ([`fit`]). Each run is single-threaded ([`DirectDem`]: the assemblies are
+//! solved one after the other on the run's thread), and the runs go side by side on a rayon
+//! pool: every figure but the wall time is independent of the thread count.
+//!
+//! Output (`DIR`): `study.csv` (one row per size), `study.json` (the rows and the fits, for
+//! plots of Figs. 4-5), `curves/curve_<V>.csv` (each size's load-displacement curve, Fig. 3).
+
+/// Nonlinear least-squares fit of the size law, with confidence intervals.
+pub mod fit;
+
+use crate::error::{Error, Result};
+use crate::job::{Job, MaterialSection};
+use crate::material::DirectDem;
+use crate::output::{CsvWriter, fmt_f64, write_atomic};
+use crate::post::CurveMetrics;
+use crate::solve::{SolutionView, Solver, StepObserver, StepReport};
+use cosdem_common::GaussPointId;
+use cosdem_worker::PackingSpec;
+use fit::{SizeLawFit, fit_size_law};
+use rayon::prelude::*;
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// What the RVE-size study runs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RveSizeSettings {
+    /// Assembly sizes V (m^2), each run once.
+    pub sizes: Vec<f64>,
+    /// Disc radius (m) replacing the job's (hexagonal packings only).
+    pub radius: Option<f64>,
+    /// Tolerance that defines V^cr (fraction: 0.01 = within 1 % of the representative value).
+    pub tolerance: f64,
+    /// Runs side by side (0: one per core).
+    pub threads: usize,
+    /// Upper end of the linear range for E (m); the paper's 0.01.
+    pub linear_range: f64,
+}
+
+impl Default for RveSizeSettings {
+    fn default() -> Self {
+        Self { sizes: Vec::new(), radius: None, tolerance: 0.01, threads: 0, linear_range: 0.01 }
+    }
+}
+
+/// One run of the study.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SizeRun {
+    /// Assembly size V (m^2).
+    pub size: f64,
+    /// Packing side sqrt(V) (m).
+    pub side: f64,
+    /// Disc radius (m) (the largest for random packings).
+    pub radius: f64,
+    /// Discs per assembly.
+    pub discs: usize,
+    /// Converged load steps.
+    pub steps: u64,
+    /// F_u, F_res, E, E50 of the curve.
+    pub metrics: CurveMetrics,
+    /// DEM steps of all accepted relaxations.
+    pub dem_steps: u64,
+    /// Wall time of the run (s); not deterministic.
+    pub wall_seconds: f64,
+    /// `finished`, or `failed: <reason>` (the metrics are then those of the finished steps).
+    pub status: String,
+}
+
+/// The fit of one property, or why there is none.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum FitOutcome {
+    /// The fitted law.
+    Fitted(Box<SizeLawFit>),
+    /// Why no fit.
+    Failed {
+        /// The reason.
+        error: String,
+    },
+}
+
+/// The whole study (also `study.json`).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RveSizeStudy {
+    /// Tolerance defining V^cr.
+    pub tolerance: f64,
+    /// One run per size, in the order of the sizes.
+    pub runs: Vec<SizeRun>,
+    /// Eq. 30: F_u (k = 2).
+    pub peak_load: FitOutcome,
+    /// Eq. 31: F_res (k = 3).
+    pub residual_load: FitOutcome,
+    /// Eq. 32: E, the slope in the linear range (k = 1).
+    pub stiffness: FitOutcome,
+    /// Eq. 32 with the Fig. 5 stiffness E50 (k = 1).
+    pub stiffness_50: FitOutcome,
+}
+
+/// The job with the assembly size `size` (and radius).
+pub fn job_for_size(job: &Job, size: f64, radius: Option<f64>) -> Result<Job> {
+    if !(size.is_finite() && size > 0.0) {
+        return Err(Error::InvalidSetting {
+            field: "sizes",
+            value: size.to_string(),
+            reason: "every size must be finite and > 0 (m^2)".into(),
+        });
+    }
+    let mut job = job.clone();
+    let MaterialSection::Dem { assembly } = &mut job.material else {
+        return Err(Error::InvalidSetting {
+            field: "material.kind",
+            value: "elastic".into(),
+            reason: "the RVE-size study needs kind = \"dem\"".into(),
+        });
+    };
+    let side = size.sqrt();
+    match &mut assembly.packing {
+        PackingSpec::Hexagonal { radius: r, side: s } => {
+            *s = side;
+            if let Some(new) = radius {
+                *r = new;
+            }
+        }
+        PackingSpec::Random { side: s, .. } => {
+            if let Some(new) = radius {
+                return Err(Error::InvalidSetting {
+                    field: "radius",
+                    value: new.to_string(),
+                    reason: "only for hexagonal packings (a random packing has r_min, r_max)"
+                        .into(),
+                });
+            }
+            *s = side;
+        }
+    }
+    job.validate()?;
+    Ok(job)
+}
+
+/// Collects the curve of one run and writes it.
+struct Curve {
+    shortening: f64,
+    load_set: String,
+    points: Vec<(f64, f64)>,
+    dem_steps: u64,
+    csv: Option<CsvWriter>,
+}
+
+impl StepObserver for Curve {
+    fn on_step(&mut self, r: &StepReport, view: &SolutionView<'_>) -> Result<()> {
+        let d = r.load_factor * self.shortening;
+        let load = -r.reactions.get(&self.load_set).map_or(0.0, |x| x[1]);
+        let dem: u64 = view.gauss_points.iter().map(|g| g.diagnostics.steps).sum();
+        self.dem_steps += dem;
+        self.points.push((d, load));
+        if let Some(csv) = &mut self.csv {
+            csv.write_row(&[r.step as f64, d, load, dem as f64])
+                .map_err(|e| Error::Observer(e.to_string()))?;
+        }
+        Ok(())
+    }
+}
+
+/// Runs the job at one size; `curve` is where its curve is written (if any).
+pub fn run_size(
+    job: &Job,
+    size: f64,
+    settings: &RveSizeSettings,
+    curve: Option<&Path>,
+) -> Result<SizeRun> {
+    let t0 = Instant::now();
+    let job = job_for_size(job, size, settings.radius)?;
+    let MaterialSection::Dem { assembly } = &job.material else { unreachable!("checked") };
+    let radius = match assembly.packing {
+        PackingSpec::Hexagonal { radius, .. } => radius,
+        PackingSpec::Random { r_max, ref radii, .. } => radii.iter().copied().fold(r_max, f64::max),
+    };
+    let mut solver = Solver::new(job.model()?, job.solver_settings()?)?;
+    let per_element = solver.gauss().per_element as u32;
+    let ids: Vec<GaussPointId> = (0..solver.model().mesh.n_elements() as u32)
+        .flat_map(|e| (0..per_element).map(move |p| GaussPointId::new(e, p)))
+        .collect();
+    let mut material = DirectDem::new(assembly, &ids)?;
+    let csv = match curve {
+        Some(p) => Some(
+            CsvWriter::create(p, &["step", "displacement", "load", "dem_steps"])
+                .map_err(|e| Error::Observer(e.to_string()))?,
+        ),
+        None => None,
+    };
+    let mut obs = Curve {
+        shortening: job.shortening(),
+        load_set: job.loading.load_set.clone(),
+        points: Vec::new(),
+        dem_steps: 0,
+        csv,
+    };
+    let outcome = solver.run(&mut material, &mut obs);
+    let status = match &outcome {
+        Ok(_) => "finished".to_string(),
+        Err(e) => format!("failed: {e}"),
+    };
+    Ok(SizeRun {
+        size,
+        side: size.sqrt(),
+        radius,
+        discs: material.disc_count(),
+        steps: obs.points.len() as u64,
+        metrics: CurveMetrics::from_curve(&obs.points, settings.linear_range),
+        dem_steps: obs.dem_steps,
+        wall_seconds: t0.elapsed().as_secs_f64(),
+        status,
+    })
+}
+
+fn fit_of(
+    runs: &[SizeRun],
+    value: impl Fn(&CurveMetrics) -> Option<f64>,
+    k: i32,
+    tol: f64,
+) -> FitOutcome {
+    let (v, f): (Vec<f64>, Vec<f64>) =
+        runs.iter().filter_map(|r| value(&r.metrics).map(|x| (r.size, x))).unzip();
+    match fit_size_law(&v, &f, k, tol) {
+        Ok(fit) => FitOutcome::Fitted(Box::new(fit)),
+        Err(e) => FitOutcome::Failed { error: e.to_string() },
+    }
+}
+
+/// Fits Eqs. 30-32 to finished runs.
+pub fn fit_runs(runs: Vec<SizeRun>, tolerance: f64) -> RveSizeStudy {
+    let peak = |m: &CurveMetrics| (m.peak_load > 0.0).then_some(m.peak_load);
+    RveSizeStudy {
+        tolerance,
+        peak_load: fit_of(&runs, peak, 2, tolerance),
+        residual_load: fit_of(&runs, |m| m.residual_load, 3, tolerance),
+        stiffness: fit_of(&runs, |m| m.stiffness, 1, tolerance),
+        stiffness_50: fit_of(&runs, |m| m.stiffness_50, 1, tolerance),
+        runs,
+    }
+}
+
+/// Runs the whole study and writes `study.csv`, `study.json` and the curves into `dir`.
+pub fn rve_size(job: &Job, settings: &RveSizeSettings, dir: &Path) -> Result<RveSizeStudy> {
+    if settings.sizes.is_empty() {
+        return Err(Error::InvalidSetting {
+            field: "sizes",
+            value: "[]".into(),
+            reason: "give at least one size (at least 3 to fit)".into(),
+        });
+    }
+    if !(settings.tolerance > 0.0 && settings.tolerance < 1.0) {
+        return Err(Error::InvalidSetting {
+            field: "tolerance",
+            value: settings.tolerance.to_string(),
+            reason: "must be in (0, 1)".into(),
+        });
+    }
+    for &v in &settings.sizes {
+        job_for_size(job, v, settings.radius)?;
+    }
+    let curves = dir.join("curves");
+    std::fs::create_dir_all(&curves)
+        .map_err(|e| Error::Observer(format!("{}: {e}", curves.display())))?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(settings.threads)
+        .build()
+        .map_err(|e| Error::Observer(format!("thread pool: {e}")))?;
+    let runs: Vec<Result<SizeRun>> = pool.install(|| {
+        settings
+            .sizes
+            .par_iter()
+            .map(|&v| {
+                let path: PathBuf = curves.join(format!("curve_{}.csv", fmt_f64(v)));
+                run_size(job, v, settings, Some(&path))
+            })
+            .collect()
+    });
+    let runs = runs.into_iter().collect::<Result<Vec<_>>>()?;
+    let study = fit_runs(runs, settings.tolerance);
+    write_study(&study, dir)?;
+    Ok(study)
+}
+
+/// Writes `study.csv` and `study.json`.
+pub fn write_study(study: &RveSizeStudy, dir: &Path) -> Result<()> {
+    let opt = |x: Option<f64>| x.map_or(String::new(), fmt_f64);
+    let mut csv = String::from(
+        "size,side,radius,discs,steps,peak_load,peak_displacement,residual_load,stiffness,\
+         stiffness_50,dem_steps,wall_seconds,status\n",
+    );
+    for r in &study.runs {
+        let m = &r.metrics;
+        csv.push_str(&format!(
+            "{},{},{},{},{},{},{},{},{},{},{},{},\"{}\"\n",
+            fmt_f64(r.size),
+            fmt_f64(r.side),
+            fmt_f64(r.radius),
+            r.discs,
+            r.steps,
+            fmt_f64(m.peak_load),
+            fmt_f64(m.peak_displacement),
+            opt(m.residual_load),
+            opt(m.stiffness),
+            opt(m.stiffness_50),
+            r.dem_steps,
+            fmt_f64(r.wall_seconds),
+            r.status.replace('"', "\"\"")
+        ));
+    }
+    let io = |e: crate::output::OutputError| Error::Observer(e.to_string());
+    write_atomic(&dir.join("study.csv"), csv.as_bytes()).map_err(io)?;
+    let json = serde_json::to_string_pretty(study).map_err(|e| Error::Observer(e.to_string()))?;
+    write_atomic(&dir.join("study.json"), format!("{json}\n").as_bytes()).map_err(io)
+}
+
+#[cfg(test)]
+mod tests;

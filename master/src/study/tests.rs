@@ -1,0 +1,87 @@
+//! The RVE-size study on three tiny sizes (a one-element confined panel, 4 Gauss points,
+//! 2 load steps, 16-36-disc assemblies): every run finishes, the results do not depend on how
+//! many runs go side by side, and the files are written.
+
+use super::*;
+
+const JOB: &str = r#"
+    [mesh]
+    kind = "rectangle"
+    lx = 1.0
+    ly = 1.0
+    nx = 1
+    ny = 1
+    [loading]
+    steps = 2
+    [loading.compression]
+    displacement = 0.004
+    [[loading.pressure]]
+    set = "left"
+    value = 1.0e5
+    [[loading.pressure]]
+    set = "right"
+    value = 1.0e5
+    [newton]
+    force_tolerance = 5.0e-3
+    displacement_tolerance = 5.0e-3
+    max_iterations = 20
+    [material]
+    kind = "dem"
+    [material.assembly]
+    packing = { kind = "hexagonal", radius = 0.005, side = 0.1 }
+"#;
+
+fn temp(name: &str) -> PathBuf {
+    std::env::temp_dir().join(format!("cosdem-study-{name}-{}", std::process::id()))
+}
+
+#[test]
+fn three_tiny_sizes_run_deterministically_and_write_files() {
+    let job = Job::from_toml(JOB, "tiny").unwrap();
+    let sizes = vec![0.0016, 0.0025, 0.0036];
+    let one = RveSizeSettings { sizes: sizes.clone(), threads: 1, ..Default::default() };
+    let two = RveSizeSettings { threads: 2, ..one.clone() };
+    let (d1, d2) = (temp("a"), temp("b"));
+    let a = rve_size(&job, &one, &d1).unwrap();
+    let b = rve_size(&job, &two, &d2).unwrap();
+    assert_eq!(a.runs.len(), 3);
+    for (x, y) in a.runs.iter().zip(&b.runs) {
+        assert_eq!(x.status, "finished", "{x:?}");
+        assert_eq!(x.steps, 2);
+        // Bit-identical whatever the number of runs side by side.
+        assert_eq!(x.metrics, y.metrics);
+        assert_eq!(x.dem_steps, y.dem_steps);
+        assert!(x.metrics.peak_load > 0.0);
+    }
+    assert!(a.runs[0].discs < a.runs[1].discs && a.runs[1].discs < a.runs[2].discs);
+    for f in ["study.csv", "study.json", "curves/curve_0.0025.csv"] {
+        assert!(d1.join(f).is_file(), "{f}");
+    }
+    let csv = std::fs::read_to_string(d1.join("study.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 4);
+    let curve = std::fs::read_to_string(d1.join("curves/curve_0.0025.csv")).unwrap();
+    assert_eq!(curve.lines().count(), 3);
+    // Three points: F_u and E fit exactly (no intervals), or say why not.
+    let json = std::fs::read_to_string(d1.join("study.json")).unwrap();
+    assert!(json.contains("peak_load") && json.contains("stiffness_50"), "{json}");
+    std::fs::remove_dir_all(&d1).unwrap();
+    std::fs::remove_dir_all(&d2).unwrap();
+}
+
+#[test]
+fn bad_sizes_and_materials_are_errors_naming_the_value() {
+    let job = Job::from_toml(JOB, "tiny").unwrap();
+    let e = job_for_size(&job, -1.0, None).unwrap_err().to_string();
+    assert!(e.contains("sizes") && e.contains("-1"), "{e}");
+    // side = 0.03 < 8 r = 0.04: the packing's own check names the key.
+    let e = job_for_size(&job, 0.0009, None).unwrap_err().to_string();
+    assert!(e.contains("packing.side"), "{e}");
+    let elastic =
+        JOB.replace("kind = \"dem\"", "kind = \"elastic\"\nshear_modulus = 1e7\npoisson = 0.3");
+    let elastic = elastic.replace(
+        "[material.assembly]\n    packing = { kind = \"hexagonal\", radius = 0.005, side = 0.1 }",
+        "",
+    );
+    let job = Job::from_toml(&elastic, "e").unwrap();
+    assert!(job_for_size(&job, 0.01, None).unwrap_err().to_string().contains("dem"));
+}
