@@ -18,11 +18,11 @@
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use cosdem_master::bench::{Workload, fe_versus_dem, overhead, rpc_floor, scaling, worker_binary};
+use cosdem_master::checkpoint::{self, Checkpoint, Checkpointer};
 use cosdem_master::job::{Job, MaterialSection};
 use cosdem_master::output::run_dir::RunWriter;
 use cosdem_master::pool::PoolConfig;
 use cosdem_master::run::{WorkerChoice, gauss_point_ids, material_for, run_settings};
-use cosdem_master::checkpoint::{self, Checkpoint, Checkpointer};
 use cosdem_master::solve::{SolutionView, Solver, StepObserver, StepReport};
 use cosdem_worker::service::Token;
 use indicatif::{ProgressBar, ProgressStyle};
@@ -544,8 +544,7 @@ fn run(args: RunArgs) -> Result<()> {
     let mut solver = Solver::new(job.model()?, job.solver_settings()?)?;
     let ids = gauss_point_ids(&solver);
     let saved = checkpoint.as_ref().map(Checkpoint::assembly_states);
-    let (mut material, workers) =
-        material_for(&job, &worker_choice(&job, &args)?, &ids, saved)?;
+    let (mut material, workers) = material_for(&job, &worker_choice(&job, &args)?, &ids, saved)?;
     if let Some(c) = checkpoint {
         solver.restore(c.solver)?;
     }

@@ -20,7 +20,6 @@ use crate::material::DirectDem;
 use crate::output::{CsvWriter, fmt_f64, write_atomic};
 use crate::post::CurveMetrics;
 use crate::solve::{SolutionView, Solver, StepObserver, StepReport};
-use cosdem_common::GaussPointId;
 use cosdem_worker::PackingSpec;
 use fit::{SizeLawFit, fit_size_law};
 use rayon::prelude::*;
@@ -182,10 +181,7 @@ pub fn run_size(
         PackingSpec::Random { r_max, ref radii, .. } => radii.iter().copied().fold(r_max, f64::max),
     };
     let mut solver = Solver::new(job.model()?, job.solver_settings()?)?;
-    let per_element = solver.gauss().per_element as u32;
-    let ids: Vec<GaussPointId> = (0..solver.model().mesh.n_elements() as u32)
-        .flat_map(|e| (0..per_element).map(move |p| GaussPointId::new(e, p)))
-        .collect();
+    let ids = crate::run::gauss_point_ids(&solver);
     let mut material = DirectDem::new(assembly, &ids)?;
     let csv = match curve {
         Some(p) => Some(
