@@ -468,6 +468,11 @@ impl Job {
                 "in (0, 1]",
             ));
         }
+        for &d in &self.output.field_plots_at {
+            if !(d.is_finite() && d >= 0.0) {
+                return Err(bad("output.field_plots_at", d, "must be finite and >= 0 (m)"));
+            }
+        }
         Ok(())
     }
 

@@ -3,7 +3,10 @@
 //! ```text
 //! cosdem run JOB.toml [--workers LIST] [--out DIR] [--token-file FILE]
 //! cosdem bench overhead|scaling|fe|all [OPTIONS]
+//! cosdem plot RUN_DIR
 //! ```
+//! `plot` (re)draws the PNG figures of a run directory into `RUN_DIR/plots/`; `run` does it
+//! at its end (a figure that fails is a warning, never a failed run).
 //! `bench` prints the coupling benchmarks of `cosdem_master::bench` (build with `--release`;
 //! the TCP runs start the `cosdem-worker` binary found next to `cosdem`).
 //! With no workers given, the DEM assemblies are solved by in-process workers (no servers to
@@ -35,6 +38,11 @@ struct Cli {
 enum Command {
     /// Run a job file.
     Run(RunArgs),
+    /// Draw the PNG figures of a run directory into RUN_DIR/plots/.
+    Plot {
+        /// The run directory (holds curve.csv).
+        run_dir: PathBuf,
+    },
     /// Benchmarks of the coupling (see `cosdem_master::bench`): printed figures.
     Bench {
         #[command(subcommand)]
@@ -293,7 +301,13 @@ fn run(args: RunArgs) -> Result<()> {
     let ids: Vec<GaussPointId> = (0..solver.model().mesh.n_elements() as u32)
         .flat_map(|e| (0..per_element).map(move |p| GaussPointId::new(e, p)))
         .collect();
+    let snapshots = cosdem_master::output::snapshots::resolve_snapshot_ids(
+        &job.output.snapshots,
+        solver.model().mesh.n_elements(),
+        per_element as usize,
+    )?;
     let (mut material, workers) = material(&job, &args, &ids)?;
+    let mut material = writer.watch(material.as_mut(), snapshots, &job.output.field_plots_at);
     writer.set_workers(workers);
     let bar = if args.quiet { ProgressBar::hidden() } else { ProgressBar::new(1000) };
     bar.set_style(
@@ -305,7 +319,7 @@ fn run(args: RunArgs) -> Result<()> {
     let outcome = {
         let mut progress =
             Progress { writer: &mut writer, bar: bar.clone(), started: Instant::now() };
-        solver.run(material.as_mut(), &mut progress)
+        solver.run(&mut material, &mut progress)
     };
     bar.finish_and_clear();
     writer.finish(outcome.as_ref().map(|_| ()).map_err(|e| e.to_string()))?;
@@ -323,7 +337,22 @@ fn run(args: RunArgs) -> Result<()> {
         s.wall_seconds,
         dir.display()
     );
+    if let Err(e) = plot(&dir) {
+        eprintln!("warning: plots: {e:#}");
+        tracing::warn!(error = %format!("{e:#}"), "plots not written");
+    }
     outcome.with_context(|| format!("run stopped; finished steps are in {}", dir.display()))?;
+    Ok(())
+}
+
+/// Draws the figures of a run directory; an error if any figure failed (after trying all).
+fn plot(dir: &Path) -> Result<()> {
+    let report = cosdem_master::output::plot::plot_run(dir)?;
+    println!("{} plots in {}", report.written.len(), dir.join("plots").display());
+    for (what, e) in &report.failed {
+        eprintln!("plot failed: {what}: {e}");
+    }
+    anyhow::ensure!(report.failed.is_empty(), "{} plot(s) failed", report.failed.len());
     Ok(())
 }
 
@@ -331,6 +360,7 @@ fn main() -> Result<()> {
     let cli = Cli::parse();
     match cli.command {
         Command::Run(args) => run(args),
+        Command::Plot { run_dir } => plot(&run_dir),
         Command::Bench { what } => bench(what),
     }
 }

@@ -4,6 +4,7 @@
 //! iteration with every Gauss point's trial kinematics, then `commit` or `rollback`. An
 //! analytical material and the DEM-backed worker pool are both implementations.
 
+use cosdem_common::micro::MicroSnapshot;
 use cosdem_common::{GaussPointId, MacroDeformation, MicroResponse};
 
 mod elastic;
@@ -75,5 +76,11 @@ pub trait Material: Send {
     /// True when the tangent is symmetric (the solver may then use Cholesky).
     fn is_symmetric(&self) -> bool {
         false
+    }
+
+    /// Particle-level picture of one Gauss point's committed state, for output; `None` when
+    /// the material has no particles (the analytical materials: the default).
+    fn snapshot(&mut self, _id: GaussPointId) -> Result<Option<MicroSnapshot>, MaterialError> {
+        Ok(None)
     }
 }

@@ -41,28 +41,15 @@ impl PvdWriter {
     /// starts an empty one if the file does not exist. Only files written by this writer (one
     /// `<DataSet .../>` element per line) are understood.
     pub fn resume(path: &Path) -> Result<Self> {
-        let text = match std::fs::read_to_string(path) {
-            Ok(t) => t,
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Self::create(path),
-            Err(e) => return Err(io_err(path, "read")(e)),
-        };
-        let mut datasets = Vec::new();
-        for (i, line) in text.lines().enumerate() {
-            let line = line.trim();
-            if !line.starts_with("<DataSet") {
-                continue;
+        let datasets = match read_pvd(path) {
+            Ok(d) => d,
+            Err(super::OutputError::Io { source, .. })
+                if source.kind() == std::io::ErrorKind::NotFound =>
+            {
+                return Self::create(path);
             }
-            let bad = |what: &str| invalid(path, format!("line {}: {what} in {line:?}", i + 1));
-            let timestep = attribute(line, "timestep")
-                .and_then(|v| v.parse::<f64>().ok())
-                .ok_or_else(|| bad("no numeric timestep"))?;
-            let part = match attribute(line, "part") {
-                Some(v) => v.parse::<u32>().map_err(|_| bad("a non-integer part"))?,
-                None => 0,
-            };
-            let file = attribute(line, "file").ok_or_else(|| bad("no file"))?;
-            datasets.push(PvdDataset { timestep, part, file });
-        }
+            Err(e) => return Err(e),
+        };
         let w = PvdWriter { path: path.to_path_buf(), datasets };
         w.flush()?;
         Ok(w)
@@ -147,6 +134,30 @@ impl PvdWriter {
     fn flush(&self) -> Result<()> {
         write_atomic(&self.path, self.to_xml().as_bytes())
     }
+}
+
+/// The datasets listed by a `.pvd` written by [`PvdWriter`] (one `<DataSet .../>` element per
+/// line), in file order; `file` as stored (relative to the `.pvd`'s directory).
+pub fn read_pvd(path: &Path) -> Result<Vec<PvdDataset>> {
+    let text = std::fs::read_to_string(path).map_err(io_err(path, "read"))?;
+    let mut datasets = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let line = line.trim();
+        if !line.starts_with("<DataSet") {
+            continue;
+        }
+        let bad = |what: &str| invalid(path, format!("line {}: {what} in {line:?}", i + 1));
+        let timestep = attribute(line, "timestep")
+            .and_then(|v| v.parse::<f64>().ok())
+            .ok_or_else(|| bad("no numeric timestep"))?;
+        let part = match attribute(line, "part") {
+            Some(v) => v.parse::<u32>().map_err(|_| bad("a non-integer part"))?,
+            None => 0,
+        };
+        let file = attribute(line, "file").ok_or_else(|| bad("no file"))?;
+        datasets.push(PvdDataset { timestep, part, file });
+    }
+    Ok(datasets)
 }
 
 /// The unescaped value of attribute `name` in one XML start tag written by [`PvdWriter`].
