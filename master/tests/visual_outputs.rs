@@ -65,8 +65,8 @@ fn settings(job: &Job) -> RunSettings {
 fn run(job: &Job, dir: &Path, material: &mut dyn Material, solver: &mut Solver) {
     let mut writer = RunWriter::create(dir, settings(job)).unwrap();
     let per = solver.gauss().per_element;
-    let ids = resolve_snapshot_ids(&job.output.snapshots, solver.model().mesh.n_elements(), per)
-        .unwrap();
+    let ids =
+        resolve_snapshot_ids(&job.output.snapshots, solver.model().mesh.n_elements(), per).unwrap();
     let mut tapped = writer.watch(material, ids, &job.output.field_plots_at);
     solver.run(&mut tapped, &mut writer).unwrap();
     writer.finish(Ok(())).unwrap();

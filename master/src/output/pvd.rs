@@ -62,8 +62,9 @@ impl PvdWriter {
 
     /// Adds `file` at `timestep` as part `part` and rewrites the `.pvd` atomically.
     ///
-    /// `file` is relative to the directory of the `.pvd`, or absolute (stored relative when it
-    /// lies inside that directory). It must already exist: write the `.vtu` first.
+    /// `file` is relative to the directory of the `.pvd`, or absolute, or relative to the
+    /// working directory through the `.pvd`'s directory (both stored relative to it). It must
+    /// already exist: write the `.vtu` first.
     pub fn add_part(&mut self, timestep: f64, part: u32, file: &Path) -> Result<()> {
         if !timestep.is_finite() {
             return Err(invalid(
@@ -72,7 +73,12 @@ impl PvdWriter {
             ));
         }
         let dir = self.dir();
-        let on_disk = if file.is_absolute() { file.to_path_buf() } else { dir.join(file) };
+        // A relative path that goes through the `.pvd`'s own (relative) directory, such as
+        // `runs/quick/vtk/mesh_00001.vtu` for `runs/quick/fields.pvd`, is taken as relative to
+        // the working directory, like the `.pvd`'s own path.
+        let through_dir = file.is_relative() && dir != Path::new(".") && file.starts_with(&dir);
+        let on_disk =
+            if file.is_absolute() || through_dir { file.to_path_buf() } else { dir.join(file) };
         if !on_disk.is_file() {
             return Err(invalid(
                 &self.path,
@@ -80,7 +86,7 @@ impl PvdWriter {
             ));
         }
         let stored = match file.strip_prefix(&dir) {
-            Ok(rel) if file.is_absolute() => rel,
+            Ok(rel) if file.is_absolute() || through_dir => rel,
             _ => file,
         };
         let stored = stored.to_string_lossy().replace('\\', "/");

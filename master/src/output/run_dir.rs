@@ -13,14 +13,14 @@
 
 use super::csv::CsvWriter;
 use super::pvd::PvdWriter;
-use super::vtk::{gauss_point_piece, nodal_piece, write_vtu};
 use super::snapshots::{SnapshotInbox, SnapshotTap};
 use super::visuals::{StepInfo, VisualOutputs};
+use super::vtk::{gauss_point_piece, nodal_piece, write_vtu};
 use super::{OutputError, Result, write_atomic};
 use crate::material::Material;
-use cosdem_common::GaussPointId;
 use crate::post::CurveMetrics;
 use crate::solve::{SolutionView, StepObserver, StepReport};
+use cosdem_common::GaussPointId;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::Instant;

@@ -142,7 +142,10 @@ impl ParticleSnapshot {
     pub fn from_micro(s: &MicroSnapshot, path: &Path) -> Result<Self> {
         let n = s.radii.len();
         let bad = |what: &str, len: usize, want: usize| {
-            invalid(path, format!("snapshot {what} has {len} values for {n} discs (expected {want})"))
+            invalid(
+                path,
+                format!("snapshot {what} has {len} values for {n} discs (expected {want})"),
+            )
         };
         if n == 0 {
             return Err(invalid(path, "snapshot has no discs".into()));
@@ -156,14 +159,21 @@ impl ParticleSnapshot {
         if s.fluctuations.len() != 2 * n {
             return Err(bad("fluctuations", s.fluctuations.len(), 2 * n));
         }
-        if s.contacts.len() % 4 != 0 {
-            return Err(invalid(path, format!("{} contact values (not 4 per contact)", s.contacts.len())));
+        if !s.contacts.len().is_multiple_of(4) {
+            return Err(invalid(
+                path,
+                format!("{} contact values (not 4 per contact)", s.contacts.len()),
+            ));
         }
         let mut contacts = Vec::with_capacity(s.contacts.len() / 4);
         for (k, c) in s.contacts.chunks(4).enumerate() {
-            let index = |v: f64| (v >= 0.0 && v.fract() == 0.0 && v < n as f64).then_some(v as usize);
+            let index =
+                |v: f64| (v >= 0.0 && v.fract() == 0.0 && v < n as f64).then_some(v as usize);
             let (Some(i), Some(j)) = (index(c[0]), index(c[1])) else {
-                return Err(invalid(path, format!("contact {k} joins discs {} and {}", c[0], c[1])));
+                return Err(invalid(
+                    path,
+                    format!("contact {k} joins discs {} and {}", c[0], c[1]),
+                ));
             };
             contacts.push((i, j, c[2], c[3]));
         }
@@ -257,7 +267,10 @@ mod tests {
         let piece = snapshot_piece(&s);
         assert_eq!(piece.points.len(), 3);
         assert_eq!(piece.cells.len(), 3 + 2);
-        assert_eq!(piece.cell_array("normal_force").unwrap().values, vec![0.0, 0.0, 0.0, 120.0, 80.0]);
+        assert_eq!(
+            piece.cell_array("normal_force").unwrap().values,
+            vec![0.0, 0.0, 0.0, 120.0, 80.0]
+        );
         assert_eq!(piece.point_array("fluctuation").unwrap().components, 3);
         write_vtu(&path, &piece).unwrap();
         assert_eq!(read_snapshot(&path).unwrap(), s);
@@ -269,14 +282,21 @@ mod tests {
     fn inconsistent_snapshots_are_refused() {
         let p = Path::new("x.vtu");
         let stand_in = MicroSnapshot { fluctuations: vec![0.1], ..Default::default() };
-        assert!(ParticleSnapshot::from_micro(&stand_in, p).unwrap_err().to_string().contains("no discs"));
+        assert!(
+            ParticleSnapshot::from_micro(&stand_in, p)
+                .unwrap_err()
+                .to_string()
+                .contains("no discs")
+        );
         let mut m = micro();
         m.contacts[1] = 7.0;
         let e = ParticleSnapshot::from_micro(&m, p).unwrap_err().to_string();
         assert!(e.contains("contact 0") && e.contains('7'), "{e}");
         let mut m = micro();
         m.fluctuations.pop();
-        assert!(ParticleSnapshot::from_micro(&m, p).unwrap_err().to_string().contains("fluctuations"));
+        assert!(
+            ParticleSnapshot::from_micro(&m, p).unwrap_err().to_string().contains("fluctuations")
+        );
     }
 
     #[test]

@@ -13,7 +13,7 @@
 use super::field_data::FieldData;
 use super::pvd::PvdWriter;
 use super::snapshots::{ParticleSnapshot, SnapshotInbox, snapshot_piece};
-use super::{OutputError, Result, io_err, write_vtu};
+use super::{Result, io_err, write_vtu};
 use crate::solve::SolutionView;
 use cosdem_common::GaussPointId;
 use std::collections::BTreeMap;
@@ -51,7 +51,11 @@ pub fn series_name(id: GaussPointId) -> String {
 
 impl VisualOutputs {
     /// Snapshots of `snapshot_ids` (delivered into `inbox`) and field data at `field_plots_at`.
-    pub fn new(snapshot_ids: Vec<GaussPointId>, field_plots_at: &[f64], inbox: SnapshotInbox) -> Self {
+    pub fn new(
+        snapshot_ids: Vec<GaussPointId>,
+        field_plots_at: &[f64],
+        inbox: SnapshotInbox,
+    ) -> Self {
         let mut pending: Vec<f64> = field_plots_at.to_vec();
         pending.sort_by(f64::total_cmp);
         Self { snapshot_ids, inbox, series: BTreeMap::new(), pending }
@@ -86,7 +90,7 @@ impl VisualOutputs {
         let mesh = view.mesh;
         let npe = mesh.kind.nodes();
         let n_el = mesh.n_elements();
-        let per = if n_el == 0 { 0 } else { view.gauss_points.len() / n_el };
+        let per = view.gauss_points.len().checked_div(n_el).unwrap_or(0);
         let data = FieldData {
             step: s.step,
             displacement: s.displacement,
@@ -125,16 +129,14 @@ impl VisualOutputs {
             }
         };
         particles.displacement = Some(s.displacement);
-        if !self.series.contains_key(&id) {
-            std::fs::create_dir_all(&sub).map_err(io_err(&sub, "create directory"))?;
-            let pvd = dir.join("snapshots").join(format!("{name}.pvd"));
-            self.series.insert(id, PvdWriter::create(&pvd)?);
-        }
+        let pvd = match self.series.entry(id) {
+            std::collections::btree_map::Entry::Occupied(e) => e.into_mut(),
+            std::collections::btree_map::Entry::Vacant(e) => {
+                std::fs::create_dir_all(&sub).map_err(io_err(&sub, "create directory"))?;
+                e.insert(PvdWriter::create(&dir.join("snapshots").join(format!("{name}.pvd")))?)
+            }
+        };
         write_vtu(&path, &snapshot_piece(&particles))?;
-        let pvd = self.series.get_mut(&id).ok_or_else(|| OutputError::InvalidData {
-            path: path.clone(),
-            message: "no series".into(),
-        })?;
         pvd.add(s.displacement, &path)
     }
 }

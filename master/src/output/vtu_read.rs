@@ -182,7 +182,9 @@ fn decode(body: &str, kind: &str, format: &str) -> std::result::Result<Vec<f64>,
             let take8 = |c: &[u8]| -> [u8; 8] { c.try_into().expect("8 bytes") };
             Ok(match kind {
                 "Float64" => data.chunks_exact(8).map(|c| f64::from_le_bytes(take8(c))).collect(),
-                "Int64" => data.chunks_exact(8).map(|c| i64::from_le_bytes(take8(c)) as f64).collect(),
+                "Int64" => {
+                    data.chunks_exact(8).map(|c| i64::from_le_bytes(take8(c)) as f64).collect()
+                }
                 "UInt8" => data.iter().map(|&b| f64::from(b)).collect(),
                 other => return Err(format!("unsupported binary type {other:?}")),
             })
@@ -203,7 +205,7 @@ fn base64(text: &str) -> std::result::Result<Vec<u8>, String> {
         } as u32)
     };
     let clean: Vec<u8> = text.bytes().filter(|b| !b.is_ascii_whitespace()).collect();
-    if clean.len() % 4 != 0 {
+    if !clean.len().is_multiple_of(4) {
         return Err("base64 text length is not a multiple of 4".into());
     }
     let mut out = Vec::with_capacity(clean.len() / 4 * 3);
@@ -211,7 +213,8 @@ fn base64(text: &str) -> std::result::Result<Vec<u8>, String> {
         let pad = chunk.iter().rev().take_while(|&&c| c == b'=').count();
         let mut n = 0u32;
         for &c in &chunk[..4 - pad] {
-            n = (n << 6) | value(c).ok_or_else(|| format!("bad base64 character {:?}", c as char))?;
+            n = (n << 6)
+                | value(c).ok_or_else(|| format!("bad base64 character {:?}", c as char))?;
         }
         n <<= 6 * pad as u32;
         let bytes = [(n >> 16) as u8, (n >> 8) as u8, n as u8];

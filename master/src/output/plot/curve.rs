@@ -1,4 +1,4 @@
-use super::{DrawResult, FONT, PlotError, Result, SIZE, register_font, si_prefix};
+use super::{DrawResult, FONT, PlotError, Result, SIZE, register_font, si_prefix, sig4};
 use crate::output::io_err;
 use crate::post::CurveMetrics;
 use plotters::prelude::*;
@@ -43,7 +43,8 @@ pub fn plot_curve(
     if curve.is_empty() {
         return Err(PlotError::NoData { path: path.to_path_buf(), message: "empty curve".into() });
     }
-    let points: Vec<(f64, f64)> = std::iter::once((0.0, 0.0)).chain(curve.iter().copied()).collect();
+    let points: Vec<(f64, f64)> =
+        std::iter::once((0.0, 0.0)).chain(curve.iter().copied()).collect();
     let dmax = points.iter().map(|p| p.0).fold(0.0, f64::max).max(1e-12);
     let fmax = points.iter().map(|p| p.1).fold(0.0, f64::max);
     let fmin = points.iter().map(|p| p.1).fold(0.0, f64::min);
@@ -101,8 +102,13 @@ pub fn plot_curve(
                 green.stroke_width(2),
             ))
             .at(path)?
-            .label(format!("E = {:.4} {prefix}N/m per m", e / div))
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], green.stroke_width(2)));
+            .label({
+                let (ediv, eprefix) = si_prefix(e);
+                format!("E = {} {eprefix}N/m per m (linear range)", sig4(e / ediv))
+            })
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 24, y)], green.stroke_width(2))
+            });
     }
     let red = RGBColor(200, 30, 30);
     let peak = scaled((metrics.peak_displacement, metrics.peak_load));
@@ -110,9 +116,11 @@ pub fn plot_curve(
         .draw_series([Cross::new(peak, 9, red.stroke_width(3))])
         .at(path)?
         .label(format!(
-            "F_u = {:.4} {prefix}N/m at d = {:.4} {dprefix}m",
-            metrics.peak_load / div,
-            metrics.peak_displacement / dd
+            "{} = {} {prefix}N/m at d = {} {dprefix}m",
+            // The last point is the highest: the curve has not passed a peak yet.
+            if metrics.residual_load.is_some() { "F_u" } else { "max load (no peak yet)" },
+            sig4(metrics.peak_load / div),
+            sig4(metrics.peak_displacement / dd)
         ))
         .legend(move |(x, y)| Cross::new((x + 12, y), 7, red.stroke_width(3)));
     chart
@@ -133,8 +141,10 @@ pub fn plot_curve(
                 orange.stroke_width(2),
             ))
             .at(path)?
-            .label(format!("F_res = {:.4} {prefix}N/m", fr / div))
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], orange.stroke_width(2)));
+            .label(format!("F_res = {} {prefix}N/m (minimum after the peak)", sig4(fr / div)))
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 24, y)], orange.stroke_width(2))
+            });
     }
     chart
         .configure_series_labels()

@@ -1,4 +1,6 @@
-use super::{DrawResult, FONT, PlotError, Result, SIZE, equal_aspect, register_font, viridis};
+use super::{
+    DrawResult, FONT, PlotError, Result, SIZE, equal_aspect, register_font, sig4, viridis,
+};
 use crate::element::{ElementKind, gauss_1d};
 use crate::output::field_data::FieldData;
 use plotters::coord::Shift;
@@ -6,7 +8,7 @@ use plotters::prelude::*;
 use std::path::Path;
 
 /// Sub-cells per element side when the field is painted.
-const SUBDIVISIONS: usize = 10;
+const SUBDIVISIONS: usize = 24;
 
 fn kind_of(nodes: usize) -> ElementKind {
     if nodes == 9 { ElementKind::Q9 } else { ElementKind::Q8 }
@@ -15,9 +17,7 @@ fn kind_of(nodes: usize) -> ElementKind {
 /// Lagrange basis through the 1D Gauss points `g` at `t`.
 fn lagrange(g: &[f64], t: f64) -> Vec<f64> {
     (0..g.len())
-        .map(|i| {
-            (0..g.len()).filter(|&j| j != i).map(|j| (t - g[j]) / (g[i] - g[j])).product()
-        })
+        .map(|i| (0..g.len()).filter(|&j| j != i).map(|j| (t - g[j]) / (g[i] - g[j])).product())
         .collect()
 }
 
@@ -70,14 +70,20 @@ pub fn plot_strain_field(f: &FieldData, title: &str, path: &Path) -> Result<()> 
         return Err(PlotError::NoData { path: path.to_path_buf(), message: "no elements".into() });
     }
     let values = nodal_values(f);
-    let vmax = values.iter().chain(&f.equivalent_strain).copied().fold(0.0, f64::max);
-    let vmax = if vmax > 0.0 { vmax } else { 1e-12 };
+    let all = || values.iter().chain(&f.equivalent_strain).copied();
+    let (lo, hi) = (all().fold(f64::INFINITY, f64::min), all().fold(0.0, f64::max));
+    // The colours span the values drawn (a uniform field: from 0), so variations show.
+    let range = if hi > 0.0 && hi - lo > 1e-6 * hi {
+        (lo, hi)
+    } else {
+        (0.0, if hi > 0.0 { hi } else { 1e-12 })
+    };
 
     let root = BitMapBackend::new(path, SIZE).into_drawing_area();
     root.fill(&WHITE).at(path)?;
     let mut heading = format!(
-        "Equivalent strain (Eq. 34) at d = {:.4} mm, step {}",
-        f.displacement * 1e3,
+        "Equivalent strain q (Eq. 34) at d = {} mm (step {}), deformed mesh at true scale",
+        sig4(f.displacement * 1e3),
         f.step
     );
     if !title.is_empty() {
@@ -89,8 +95,8 @@ pub fn plot_strain_field(f: &FieldData, title: &str, path: &Path) -> Result<()> 
     }
     let (w, _) = area.dim_in_pixel();
     let (main, bar) = area.split_horizontally(w - 170);
-    draw_mesh(&main, f, &values, vmax, path)?;
-    draw_colour_bar(&bar, vmax, path)?;
+    draw_mesh(&main, f, &values, range, path)?;
+    draw_colour_bar(&bar, range, path)?;
     root.present().at(path)?;
     Ok(())
 }
@@ -99,7 +105,7 @@ fn draw_mesh<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     f: &FieldData,
     values: &[f64],
-    vmax: f64,
+    (lo, hi): (f64, f64),
     path: &Path,
 ) -> Result<()> {
     let mut bx = (f64::INFINITY, f64::NEG_INFINITY);
@@ -141,7 +147,7 @@ fn draw_mesh<DB: DrawingBackend>(
                 };
                 let centre = [0.5 * (t(i) + t(i + 1)), 0.5 * (t(j) + t(j + 1))];
                 let (_, v) = interpolate(f, e, values, centre);
-                let colour = viridis(v / vmax);
+                let colour = viridis((v - lo) / (hi - lo));
                 cells.push(Polygon::new(
                     vec![corner(0, 0), corner(1, 0), corner(1, 1), corner(0, 1)],
                     colour.filled(),
@@ -187,7 +193,7 @@ fn draw_mesh<DB: DrawingBackend>(
 
 fn draw_colour_bar<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
-    vmax: f64,
+    (lo, hi): (f64, f64),
     path: &Path,
 ) -> Result<()> {
     let mut chart = ChartBuilder::on(area)
@@ -196,12 +202,13 @@ fn draw_colour_bar<DB: DrawingBackend>(
         .margin_left(10)
         .margin_right(5)
         .set_label_area_size(LabelAreaPosition::Right, 110)
-        .build_cartesian_2d(0.0..1.0, 0.0..vmax)
+        .build_cartesian_2d(0.0..1.0, lo..hi)
         .at(path)?;
     let n = 256;
     chart
         .draw_series((0..n).map(|i| {
-            let (a, b) = (vmax * i as f64 / n as f64, vmax * (i + 1) as f64 / n as f64);
+            let a = lo + (hi - lo) * i as f64 / n as f64;
+            let b = lo + (hi - lo) * (i + 1) as f64 / n as f64;
             Rectangle::new([(0.0, a), (1.0, b)], viridis((i as f64 + 0.5) / n as f64).filled())
         }))
         .at(path)?;
@@ -209,15 +216,14 @@ fn draw_colour_bar<DB: DrawingBackend>(
         .configure_mesh()
         .disable_mesh()
         .disable_x_axis()
+        .set_tick_mark_size(LabelAreaPosition::Right, 6)
         .y_desc("equivalent strain q (-)")
-        .y_label_formatter(&|v| format!("{v:.2e}"))
+        .y_label_formatter(&|v| format!(" {v:.3e}"))
         .label_style((FONT, 16))
         .axis_desc_style((FONT, 18))
         .draw()
         .at(path)?;
-    chart
-        .draw_series([Rectangle::new([(0.0, 0.0), (1.0, vmax)], BLACK.stroke_width(1))])
-        .at(path)?;
+    chart.draw_series([Rectangle::new([(0.0, lo), (1.0, hi)], BLACK.stroke_width(1))]).at(path)?;
     Ok(())
 }
 
@@ -226,7 +232,8 @@ mod tests {
     use super::*;
 
     fn sample(q: impl Fn([f64; 2]) -> f64) -> FieldData {
-        let mesh = crate::mesh::Mesh::rectangle(ElementKind::Q8, 1.0, 1.0, 2, 2, [0.0, 0.0]).unwrap();
+        let mesh =
+            crate::mesh::Mesh::rectangle(ElementKind::Q8, 1.0, 1.0, 2, 2, [0.0, 0.0]).unwrap();
         let (g, _) = gauss_1d(2);
         let mut strain = Vec::new();
         for e in 0..mesh.n_elements() {

@@ -66,7 +66,8 @@ pub fn register_font() {
     static ONCE: std::sync::Once = std::sync::Once::new();
     ONCE.call_once(|| {
         // The font is compiled in and parsed by the tests: registration cannot fail.
-        let _ = plotters::style::register_font(FONT, plotters::style::FontStyle::Normal, FONT_BYTES);
+        let _ =
+            plotters::style::register_font(FONT, plotters::style::FontStyle::Normal, FONT_BYTES);
     });
 }
 
@@ -164,7 +165,7 @@ pub fn plot_run(run: &Path) -> Result<PlotReport> {
         }
         for f in chosen {
             let step = step_of(f);
-            let label = format!("{} ({series})", gauss_label(&series));
+            let label = gauss_label(&series);
             match read_snapshot(f) {
                 Ok(s) => {
                     let target = out.join(format!("force_chains_{series}_{step:05}.png"));
@@ -188,7 +189,10 @@ pub fn plot_run(run: &Path) -> Result<PlotReport> {
 /// "Gauss point 3 of element 12" from the series name `e12_p3`.
 fn gauss_label(series: &str) -> String {
     let mut parts = series.split('_');
-    match (parts.next().and_then(|e| e.strip_prefix('e')), parts.next().and_then(|p| p.strip_prefix('p'))) {
+    match (
+        parts.next().and_then(|e| e.strip_prefix('e')),
+        parts.next().and_then(|p| p.strip_prefix('p')),
+    ) {
         (Some(e), Some(p)) => format!("element {e}, Gauss point {p}"),
         _ => series.to_string(),
     }
@@ -207,7 +211,10 @@ fn sorted_files(dir: &Path, prefix: &str, suffix: &str) -> Vec<PathBuf> {
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| {
             let name = p.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-            p.is_file() && name.starts_with(prefix) && name.ends_with(suffix) && !name.starts_with('.')
+            p.is_file()
+                && name.starts_with(prefix)
+                && name.ends_with(suffix)
+                && !name.starts_with('.')
         })
         .collect();
     files.sort();
@@ -268,6 +275,20 @@ pub fn si_prefix(scale: f64) -> (f64, &'static str) {
     (1e-9, "n")
 }
 
+/// `x` with 4 significant digits in plain notation (`227.97` -> `228.0`, `0.0012345` ->
+/// `0.001235`); scientific beyond 1e6 or below 1e-4.
+pub fn sig4(x: f64) -> String {
+    let a = x.abs();
+    if !x.is_finite() || a == 0.0 {
+        return format!("{x}");
+    }
+    if !(1e-4..1e6).contains(&a) {
+        return format!("{x:.3e}");
+    }
+    let decimals = (3 - a.log10().floor() as i32).max(0) as usize;
+    format!("{x:.decimals$}")
+}
+
 /// Ranges `(x, y)` containing `[x0, x1] x [y0, y1]` with `pad` (fraction) around it and the
 /// same scale per pixel on both axes in a plotting area of `px` pixels.
 pub fn equal_aspect(
@@ -290,7 +311,14 @@ mod tests {
 
     #[test]
     fn embedded_font_parses() {
-        assert!(plotters::style::register_font("test-font", plotters::style::FontStyle::Normal, FONT_BYTES).is_ok());
+        assert!(
+            plotters::style::register_font(
+                "test-font",
+                plotters::style::FontStyle::Normal,
+                FONT_BYTES
+            )
+            .is_ok()
+        );
     }
 
     #[test]
@@ -299,6 +327,10 @@ mod tests {
         assert_eq!(step_of(Path::new("snap_00003.vtu")), 3);
         assert_eq!(gauss_label("e12_p3"), "element 12, Gauss point 3");
         assert_eq!(si_prefix(2.5e4), (1e3, "k"));
+        assert_eq!(sig4(227.9722), "228.0");
+        assert_eq!(sig4(2.53412), "2.534");
+        assert_eq!(sig4(-0.00123456), "-0.001235");
+        assert_eq!(sig4(5e7), "5.000e7");
         assert_eq!(si_prefix(0.3), (1e-3, "m"));
         assert_eq!(viridis(0.0), plotters::style::RGBColor(68, 1, 84));
         assert_eq!(viridis(1.0), plotters::style::RGBColor(253, 231, 37));

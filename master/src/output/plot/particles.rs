@@ -1,10 +1,13 @@
-use super::{DrawResult, FONT, PlotError, Result, SIZE, equal_aspect, register_font, si_prefix};
+use super::{
+    DrawResult, FONT, PlotError, Result, SIZE, equal_aspect, register_font, si_prefix, sig4,
+};
 use crate::output::snapshots::ParticleSnapshot;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use std::path::Path;
 
-type Chart<'a, 'b> = ChartContext<'a, BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+type Chart<'a, 'b> =
+    ChartContext<'a, BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
 /// Vertices of a disc outline.
 const DISC_VERTICES: usize = 28;
@@ -19,11 +22,12 @@ fn disc(c: [f64; 2], r: f64) -> Vec<(f64, f64)> {
 }
 
 /// Opens the figure, draws the title, axes (equal scale, mm) and the discs; hands the chart to
-/// `draw` for the rest.
+/// `draw` for the rest. The axes also take in the `extra` points (m).
 fn particle_figure(
     s: &ParticleSnapshot,
     heading: &str,
     fill: RGBColor,
+    extra: &[[f64; 2]],
     path: &Path,
     draw: impl FnOnce(&mut Chart<'_, '_>) -> Result<()>,
 ) -> Result<()> {
@@ -36,6 +40,10 @@ fn particle_figure(
     for (c, r) in s.centres.iter().zip(&s.radius) {
         bx = (bx.0.min(c[0] - r), bx.1.max(c[0] + r));
         by = (by.0.min(c[1] - r), by.1.max(c[1] + r));
+    }
+    for p in extra {
+        bx = (bx.0.min(p[0]), bx.1.max(p[0]));
+        by = (by.0.min(p[1]), by.1.max(p[1]));
     }
     let root = BitMapBackend::new(path, SIZE).into_drawing_area();
     root.fill(&WHITE).at(path)?;
@@ -79,21 +87,13 @@ fn particle_figure(
         }))
         .at(path)?;
     draw(&mut chart)?;
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .label_font((FONT, 17))
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK.mix(0.5))
-        .draw()
-        .at(path)?;
     root.present().at(path)?;
     Ok(())
 }
 
-fn heading(what: &str, s: &ParticleSnapshot, label: &str) -> String {
-    let at = s.displacement.map_or(String::new(), |d| format!(" at d = {:.4} mm", d * 1e3));
-    format!("{what}{at}\n{label}, {} discs", s.centres.len())
+fn heading(what: &str, s: &ParticleSnapshot, label: &str, detail: &str) -> String {
+    let at = s.displacement.map_or(String::new(), |d| format!(" at d = {} mm", sig4(d * 1e3)));
+    format!("{what}{at}, {label}\n{} discs; {detail}", s.centres.len())
 }
 
 /// True for a contact drawn as a segment: not one across a periodic cell (its two centres
@@ -116,52 +116,58 @@ pub fn plot_force_chains(s: &ParticleSnapshot, label: &str, path: &Path) -> Resu
     contacts.sort_by(|a, b| a.2.total_cmp(&b.2));
     let fmax = contacts.last().map_or(0.0, |c| c.2);
     let (div, prefix) = si_prefix(fmax);
-    let title = heading("Contact force chains", s, label);
-    particle_figure(s, &title, RGBColor(238, 238, 238), path, |chart| {
+    let detail = format!(
+        "{} contacts drawn, line width ∝ normal force (max {} {prefix}N/m)",
+        contacts.len(),
+        sig4(fmax / div)
+    );
+    let title = heading("Contact force chains", s, label, &detail);
+    particle_figure(s, &title, RGBColor(238, 238, 238), &[], path, |chart| {
         let chain = RGBColor(170, 20, 20);
-        let width = |f: f64| (1.0 + 11.0 * f / fmax).round() as u32;
-        let mut first = true;
-        for &(i, j, f) in &contacts {
+        // The widest line is 0.3 mean disc radii (2 to 10 pixels), so chains stay
+        // readable over dense packings.
+        let rmean = s.radius.iter().sum::<f64>() / s.radius.len() as f64 * 1e3;
+        let (a, b) = (chart.backend_coord(&(0.0, 0.0)), chart.backend_coord(&(rmean, 0.0)));
+        let wmax = (0.3 * f64::from(b.0 - a.0)).clamp(2.0, 10.0);
+        let width = |f: f64| (1.0 + (wmax - 1.0) * f / fmax).round() as u32;
+        let segments = contacts.iter().map(|&(i, j, f)| {
             let (a, b) = (s.centres[i], s.centres[j]);
             let seg = vec![(a[0] * 1e3, a[1] * 1e3), (b[0] * 1e3, b[1] * 1e3)];
-            let drawn = chart
-                .draw_series([PathElement::new(seg, chain.stroke_width(width(f)))])
-                .at(path)?;
-            if first {
-                drawn.label(format!(
-                    "normal force, width ∝ f_n ({} contacts, max {:.3} {prefix}N/m)",
-                    contacts.len(),
-                    fmax / div
-                ));
-                drawn.legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 24, y)], chain.stroke_width(6))
-                });
-                first = false;
-            }
-        }
+            PathElement::new(seg, chain.stroke_width(width(f)))
+        });
+        chart.draw_series(segments).at(path)?;
         Ok(())
     })
 }
 
 /// Fig. 12: the fluctuation field of Eq. 35 (each disc's displacement minus the affine part
 /// of the macro deformation) as arrows from the disc centres, magnified so that the longest
-/// is about a disc diameter and a half long.
+/// is 2.5 mean radii long.
 pub fn plot_fluctuations(s: &ParticleSnapshot, label: &str, path: &Path) -> Result<()> {
     let umax = s.fluctuation.iter().map(|u| u[0].hypot(u[1])).fold(0.0, f64::max);
     let rmean = s.radius.iter().sum::<f64>() / s.radius.len().max(1) as f64;
-    let scale = if umax > 0.0 { 3.0 * rmean / umax } else { 0.0 };
-    let title = heading("Displacement fluctuations u_R (Eq. 35)", s, label);
-    particle_figure(s, &title, RGBColor(248, 248, 248), path, |chart| {
+    let scale = if umax > 0.0 { 2.5 * rmean / umax } else { 0.0 };
+    let tips: Vec<[f64; 2]> = s
+        .centres
+        .iter()
+        .zip(&s.fluctuation)
+        .map(|(c, u)| [c[0] + scale * u[0], c[1] + scale * u[1]])
+        .collect();
+    let (div, prefix) = si_prefix(umax);
+    let detail =
+        format!("arrows magnified {}×, longest {} {prefix}m", sig4(scale), sig4(umax / div));
+    let title = heading("Fluctuations u_R (Eq. 35)", s, label, &detail);
+    particle_figure(s, &title, RGBColor(248, 248, 248), &tips, path, |chart| {
         let ink = RGBColor(20, 60, 150);
         let mut arrows = Vec::new();
-        for (c, u) in s.centres.iter().zip(&s.fluctuation) {
+        for (c, t) in s.centres.iter().zip(&tips) {
             let (x0, y0) = (c[0] * 1e3, c[1] * 1e3);
-            let (dx, dy) = (u[0] * scale * 1e3, u[1] * scale * 1e3);
+            let (x1, y1) = (t[0] * 1e3, t[1] * 1e3);
+            let (dx, dy) = (x1 - x0, y1 - y0);
             let len = dx.hypot(dy);
             if len <= 0.0 {
                 continue;
             }
-            let (x1, y1) = (x0 + dx, y0 + dy);
             arrows.push(vec![(x0, y0), (x1, y1)]);
             // Head: two strokes at 25 degrees, 30 % of the arrow but at most a radius long.
             let h = (0.3 * len).min(rmean * 1e3);
@@ -172,15 +178,9 @@ pub fn plot_fluctuations(s: &ParticleSnapshot, label: &str, path: &Path) -> Resu
                 arrows.push(vec![(x1, y1), (x1 - h * rx, y1 - h * ry)]);
             }
         }
-        let (div, prefix) = si_prefix(umax);
         chart
             .draw_series(arrows.into_iter().map(|p| PathElement::new(p, ink.stroke_width(2))))
-            .at(path)?
-            .label(format!(
-                "u_R, magnified {scale:.0}x (longest {:.3} {prefix}m)",
-                umax / div
-            ))
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 24, y)], ink.stroke_width(2)));
+            .at(path)?;
         Ok(())
     })
 }
