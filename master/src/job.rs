@@ -551,6 +551,11 @@ impl Job {
                 "in [1e-12, 1]",
             ));
         }
+        for &d in &self.output.field_plots_at {
+            if !(d.is_finite() && d >= 0.0) {
+                return Err(bad("output.field_plots_at", d, "must be finite and >= 0 (m)"));
+            }
+        }
         Ok(())
     }
 

@@ -80,6 +80,23 @@ fn missing_dataset_is_refused_and_the_collection_kept() {
     assert_eq!(read_pvd(&path)[1], (0.75, 2, "mesh_0001.vtu".to_string()));
 }
 
+/// A run directory given relative to the working directory (`cosdem run` writes
+/// `runs/<job>/` by default): the `.vtu` path through it is stored relative to the `.pvd`.
+#[test]
+fn paths_relative_to_the_working_directory() {
+    let dir = scratch("pvd-relative");
+    let cwd = std::env::current_dir().unwrap();
+    let ups = "../".repeat(cwd.components().count() - 1);
+    let rel = Path::new(&ups).join(dir.strip_prefix("/").unwrap());
+    assert!(rel.is_relative() && rel.join(".").exists());
+    std::fs::create_dir_all(rel.join("vtk")).unwrap();
+    let mut pvd = PvdWriter::create(&rel.join("fields.pvd")).unwrap();
+    let vtu = rel.join("vtk/mesh_00001.vtu");
+    write_vtu(&vtu, &VtuPiece::point_cloud_2d(&[[0.0, 0.0]])).unwrap();
+    pvd.add(0.5, &vtu).unwrap();
+    assert_eq!(read_pvd(&dir.join("fields.pvd")), vec![(0.5, 0, "vtk/mesh_00001.vtu".into())]);
+}
+
 #[test]
 fn resume_continues_and_truncates() {
     let dir = scratch("pvd-resume");

@@ -6,10 +6,13 @@
 //!     [--pressure P] [--out DIR]
 //! cosdem study rve-size JOB.toml --sizes V1,V2,... [--radius R] [--out DIR]
 //! cosdem bench overhead|scaling|fe|all [OPTIONS]
+//! cosdem plot RUN_DIR
 //! ```
 //! `run` checkpoints into `RUN/checkpoint.bin` (every `[output] checkpoint_every` steps);
 //! Ctrl-C stops after the current step (checkpoint written, status `interrupted`, exit code
 //! 130) and `--resume` continues from the checkpoint.
+//! `plot` (re)draws the PNG figures of a run directory into `RUN_DIR/plots/`; `run` does it
+//! at its end (a figure that fails is a warning, never a failed run).
 //! `bench` prints the coupling benchmarks of `cosdem_master::bench` (build with `--release`;
 //! the TCP runs start the `cosdem-worker` binary found next to `cosdem`).
 //! With no workers given, the DEM assemblies are solved by in-process workers (no servers to
@@ -46,6 +49,11 @@ enum Command {
     Study {
         #[command(subcommand)]
         what: StudyWhat,
+    },
+    /// Draw the PNG figures of a run directory into RUN_DIR/plots/.
+    Plot {
+        /// The run directory (holds curve.csv).
+        run_dir: PathBuf,
     },
     /// Benchmarks of the coupling (see `cosdem_master::bench`): printed figures.
     Bench {
@@ -543,12 +551,18 @@ fn run(args: RunArgs) -> Result<()> {
     };
     let mut solver = Solver::new(job.model()?, job.solver_settings()?)?;
     let ids = gauss_point_ids(&solver);
+    let snapshots = cosdem_master::output::snapshots::resolve_snapshot_ids(
+        &job.output.snapshots,
+        solver.model().mesh.n_elements(),
+        solver.gauss().per_element,
+    )?;
     let saved = checkpoint.as_ref().map(Checkpoint::assembly_states);
     let (mut material, workers) = material_for(&job, &worker_choice(&job, &args)?, &ids, saved)?;
     if let Some(c) = checkpoint {
         solver.restore(c.solver)?;
     }
     let stop = checkpoint::ctrl_c_flag().context("installing the Ctrl-C handler")?;
+    let mut material = writer.watch(material.as_mut(), snapshots, &job.output.field_plots_at);
     writer.set_workers(workers);
     let bar = if args.quiet { ProgressBar::hidden() } else { ProgressBar::new(1000) };
     bar.set_style(
@@ -561,7 +575,7 @@ fn run(args: RunArgs) -> Result<()> {
         let progress = Progress { writer: &mut writer, bar: bar.clone(), started: Instant::now() };
         let every = job.output.checkpoint_every;
         let mut observer = Checkpointer::new(progress, &dir, every, &job, stop);
-        solver.run(material.as_mut(), &mut observer)
+        solver.run(&mut material, &mut observer)
     };
     bar.finish_and_clear();
     let interrupted = matches!(outcome, Err(cosdem_master::Error::Interrupted { .. }));
@@ -584,6 +598,10 @@ fn run(args: RunArgs) -> Result<()> {
         s.wall_seconds,
         dir.display()
     );
+    if let Err(e) = plot(&dir) {
+        eprintln!("warning: plots: {e:#}");
+        tracing::warn!(error = %format!("{e:#}"), "plots not written");
+    }
     if s.skipped_relaxations + s.linear_answers > 0 {
         println!(
             "answers without relaxation: {} skipped, {} linear (largest stress-error bound {:.3e} Pa)",
@@ -602,12 +620,24 @@ fn run(args: RunArgs) -> Result<()> {
     Ok(())
 }
 
+/// Draws the figures of a run directory; an error if any figure failed (after trying all).
+fn plot(dir: &Path) -> Result<()> {
+    let report = cosdem_master::output::plot::plot_run(dir)?;
+    println!("{} plots in {}", report.written.len(), dir.join("plots").display());
+    for (what, e) in &report.failed {
+        eprintln!("plot failed: {what}: {e}");
+    }
+    anyhow::ensure!(report.failed.is_empty(), "{} plot(s) failed", report.failed.len());
+    Ok(())
+}
+
 fn main() -> Result<()> {
     let cli = Cli::parse();
     match cli.command {
         Command::Run(args) => run(args),
         Command::Rve(args) => rve(args),
         Command::Study { what } => study(what),
+        Command::Plot { run_dir } => plot(&run_dir),
         Command::Bench { what } => bench(what),
     }
 }

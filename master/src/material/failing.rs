@@ -81,4 +81,11 @@ impl<M: Material> Material for FailureInjector<M> {
     fn is_symmetric(&self) -> bool {
         self.inner.is_symmetric()
     }
+
+    fn snapshot(
+        &mut self,
+        id: GaussPointId,
+    ) -> Result<Option<cosdem_common::micro::MicroSnapshot>, MaterialError> {
+        self.inner.snapshot(id)
+    }
 }

@@ -5,6 +5,7 @@
 //! analytical material and the DEM-backed worker pool are both implementations.
 
 use cosdem_common::micro::AssemblyState;
+use cosdem_common::micro::MicroSnapshot;
 use cosdem_common::{GaussPointId, MacroDeformation, MicroResponse};
 
 mod direct;
@@ -91,5 +92,11 @@ pub trait Material: Send {
     fn restore_states(&mut self, states: Vec<AssemblyState>) -> Result<(), MaterialError> {
         let _ = states;
         Ok(())
+    }
+
+    /// Particle-level picture of one Gauss point's committed state, for output; `None` when
+    /// the material has no particles (the analytical materials: the default).
+    fn snapshot(&mut self, _id: GaussPointId) -> Result<Option<MicroSnapshot>, MaterialError> {
+        Ok(None)
     }
 }

@@ -10,15 +10,25 @@
 
 /// CSV curves (load-displacement), one flushed row per converged step.
 pub mod csv;
+/// The equivalent-strain field of chosen steps as JSON, for the Fig. 9 plot.
+pub mod field_data;
+/// PNG figures of a run directory (plotters, embedded font): Figs. 3, 9, 10-12.
+pub mod plot;
 /// ParaView `.pvd` collections: the time series of `.vtu` files.
 pub mod pvd;
 /// The run directory written as the run goes: curve, VTK series, summary.
 pub mod run_dir;
+/// Particle snapshots of chosen Gauss points: fetched after each commit, VTK out and back.
+pub mod snapshots;
+/// Snapshots and field data written by the run writer at chosen steps.
+pub mod visuals;
 /// VTK XML unstructured grids (`.vtu`): meshes, Gauss-point clouds, particle snapshots.
 pub mod vtk;
+/// Reading back the `.vtu` files this crate writes.
+pub mod vtu_read;
 
 pub use csv::CsvWriter;
-pub use pvd::{PvdDataset, PvdWriter};
+pub use pvd::{PvdDataset, PvdWriter, read_pvd};
 pub use vtk::{
     Cell, CellType, DataArray, Encoding, VtuPiece, gauss_point_piece, nodal_piece, particle_piece,
     write_vtu, write_vtu_encoded,

@@ -41,28 +41,15 @@ impl PvdWriter {
     /// starts an empty one if the file does not exist. Only files written by this writer (one
     /// `<DataSet .../>` element per line) are understood.
     pub fn resume(path: &Path) -> Result<Self> {
-        let text = match std::fs::read_to_string(path) {
-            Ok(t) => t,
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Self::create(path),
-            Err(e) => return Err(io_err(path, "read")(e)),
-        };
-        let mut datasets = Vec::new();
-        for (i, line) in text.lines().enumerate() {
-            let line = line.trim();
-            if !line.starts_with("<DataSet") {
-                continue;
+        let datasets = match read_pvd(path) {
+            Ok(d) => d,
+            Err(super::OutputError::Io { source, .. })
+                if source.kind() == std::io::ErrorKind::NotFound =>
+            {
+                return Self::create(path);
             }
-            let bad = |what: &str| invalid(path, format!("line {}: {what} in {line:?}", i + 1));
-            let timestep = attribute(line, "timestep")
-                .and_then(|v| v.parse::<f64>().ok())
-                .ok_or_else(|| bad("no numeric timestep"))?;
-            let part = match attribute(line, "part") {
-                Some(v) => v.parse::<u32>().map_err(|_| bad("a non-integer part"))?,
-                None => 0,
-            };
-            let file = attribute(line, "file").ok_or_else(|| bad("no file"))?;
-            datasets.push(PvdDataset { timestep, part, file });
-        }
+            Err(e) => return Err(e),
+        };
         let w = PvdWriter { path: path.to_path_buf(), datasets };
         w.flush()?;
         Ok(w)
@@ -75,8 +62,9 @@ impl PvdWriter {
 
     /// Adds `file` at `timestep` as part `part` and rewrites the `.pvd` atomically.
     ///
-    /// `file` is relative to the directory of the `.pvd`, or absolute (stored relative when it
-    /// lies inside that directory). It must already exist: write the `.vtu` first.
+    /// `file` is relative to the directory of the `.pvd`, or absolute, or relative to the
+    /// working directory through the `.pvd`'s directory (both stored relative to it). It must
+    /// already exist: write the `.vtu` first.
     pub fn add_part(&mut self, timestep: f64, part: u32, file: &Path) -> Result<()> {
         if !timestep.is_finite() {
             return Err(invalid(
@@ -85,7 +73,12 @@ impl PvdWriter {
             ));
         }
         let dir = self.dir();
-        let on_disk = if file.is_absolute() { file.to_path_buf() } else { dir.join(file) };
+        // A relative path that goes through the `.pvd`'s own (relative) directory, such as
+        // `runs/quick/vtk/mesh_00001.vtu` for `runs/quick/fields.pvd`, is taken as relative to
+        // the working directory, like the `.pvd`'s own path.
+        let through_dir = file.is_relative() && dir != Path::new(".") && file.starts_with(&dir);
+        let on_disk =
+            if file.is_absolute() || through_dir { file.to_path_buf() } else { dir.join(file) };
         if !on_disk.is_file() {
             return Err(invalid(
                 &self.path,
@@ -93,7 +86,7 @@ impl PvdWriter {
             ));
         }
         let stored = match file.strip_prefix(&dir) {
-            Ok(rel) if file.is_absolute() => rel,
+            Ok(rel) if file.is_absolute() || through_dir => rel,
             _ => file,
         };
         let stored = stored.to_string_lossy().replace('\\', "/");
@@ -147,6 +140,30 @@ impl PvdWriter {
     fn flush(&self) -> Result<()> {
         write_atomic(&self.path, self.to_xml().as_bytes())
     }
+}
+
+/// The datasets listed by a `.pvd` written by [`PvdWriter`] (one `<DataSet .../>` element per
+/// line), in file order; `file` as stored (relative to the `.pvd`'s directory).
+pub fn read_pvd(path: &Path) -> Result<Vec<PvdDataset>> {
+    let text = std::fs::read_to_string(path).map_err(io_err(path, "read"))?;
+    let mut datasets = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let line = line.trim();
+        if !line.starts_with("<DataSet") {
+            continue;
+        }
+        let bad = |what: &str| invalid(path, format!("line {}: {what} in {line:?}", i + 1));
+        let timestep = attribute(line, "timestep")
+            .and_then(|v| v.parse::<f64>().ok())
+            .ok_or_else(|| bad("no numeric timestep"))?;
+        let part = match attribute(line, "part") {
+            Some(v) => v.parse::<u32>().map_err(|_| bad("a non-integer part"))?,
+            None => 0,
+        };
+        let file = attribute(line, "file").ok_or_else(|| bad("no file"))?;
+        datasets.push(PvdDataset { timestep, part, file });
+    }
+    Ok(datasets)
 }
 
 /// The unescaped value of attribute `name` in one XML start tag written by [`PvdWriter`].

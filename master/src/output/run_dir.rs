@@ -6,17 +6,22 @@
 //! RUN/fields.pvd       ParaView collection of RUN/vtk/mesh_NNNNN.vtu (u, w per node)
 //! RUN/gauss.pvd        ParaView collection of RUN/vtk/gauss_NNNNN.vtu (stress, strain, q)
 //! RUN/summary.json     metrics so far (F_u, F_res, E, E50), DEM totals, status, wall time
+//! RUN/snapshots/, RUN/fields/   particle snapshots and field data (see `super::visuals`)
 //! ```
 //! Everything but `summary.json`'s timing and worker fields is a deterministic function of the
 //! job, so two runs can be compared byte for byte.
 
 use super::csv::CsvWriter;
 use super::pvd::PvdWriter;
+use super::snapshots::{SnapshotInbox, SnapshotTap};
+use super::visuals::{StepInfo, VisualOutputs};
 use super::vtk::{gauss_point_piece, nodal_piece, write_vtu};
 use super::{OutputError, Result, write_atomic};
+use crate::material::Material;
 use crate::post::CurveMetrics;
 use crate::solve::{SolutionView, StepObserver, StepReport};
 use cosdem_common::Answer;
+use cosdem_common::GaussPointId;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -98,6 +103,7 @@ pub struct RunWriter {
     curve: Vec<(f64, f64)>,
     summary: Summary,
     started: Instant,
+    visuals: VisualOutputs,
 }
 
 impl RunWriter {
@@ -146,6 +152,7 @@ impl RunWriter {
             curve: Vec::new(),
             summary,
             started: Instant::now(),
+            visuals: VisualOutputs::default(),
         };
         w.write_summary()?;
         Ok(w)
@@ -234,8 +241,17 @@ impl RunWriter {
         let started = Instant::now()
             .checked_sub(std::time::Duration::from_secs_f64(before.max(0.0)))
             .unwrap_or_else(Instant::now);
-        let mut w =
-            Self { dir: dir.to_path_buf(), settings, csv, fields, gauss, curve, summary, started };
+        let mut w = Self {
+            dir: dir.to_path_buf(),
+            settings,
+            csv,
+            fields,
+            gauss,
+            curve,
+            summary,
+            started,
+            visuals: VisualOutputs::default(),
+        };
         w.write_summary()?;
         Ok(w)
     }
@@ -260,6 +276,21 @@ impl RunWriter {
     /// The summary so far.
     pub fn summary(&self) -> &Summary {
         &self.summary
+    }
+
+    /// Asks for particle snapshots of `snapshots` (written with the VTK cadence, at the
+    /// `field_plots_at` displacements and at the last step) and for the field data of
+    /// `field_plots_at` and the last step. Returns `material` wrapped so that it hands the
+    /// snapshots over at every commit: run the solver with the wrapper.
+    pub fn watch<'m>(
+        &mut self,
+        material: &'m mut dyn Material,
+        snapshots: Vec<GaussPointId>,
+        field_plots_at: &[f64],
+    ) -> SnapshotTap<'m> {
+        let inbox = SnapshotInbox::default();
+        self.visuals = VisualOutputs::new(snapshots.clone(), field_plots_at, inbox.clone());
+        SnapshotTap::new(material, snapshots, inbox)
     }
 
     /// Records the number of workers in the summary.
@@ -360,9 +391,18 @@ impl StepObserver for RunWriter {
         let io = |e: OutputError| crate::Error::Observer(e.to_string());
         self.csv.write_row(&row).map_err(io)?;
         let every = self.settings.vtk_every;
-        if every > 0 && report.step.is_multiple_of(every as u64) {
+        let on_cadence = every > 0 && report.step.is_multiple_of(every as u64);
+        if on_cadence {
             self.write_vtk(report.step, view).map_err(io)?;
         }
+        let info = StepInfo {
+            step: report.step,
+            displacement,
+            last: report.load_factor >= 1.0 - 1e-12,
+            on_cadence,
+            internal_length: self.settings.internal_length,
+        };
+        self.visuals.on_step(&self.dir, info, view).map_err(io)?;
         self.write_summary().map_err(io)
     }
 }

@@ -1217,4 +1217,8 @@ impl Material for Pool {
         let h = self.handle.clone();
         h.block_on(self.import_states(states))
     }
+
+    fn snapshot(&mut self, id: GaussPointId) -> Result<Option<MicroSnapshot>, MaterialError> {
+        Pool::snapshot(self, id).map(Some).map_err(|e| MaterialError::Unavailable(e.to_string()))
+    }
 }
