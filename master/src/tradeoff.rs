@@ -357,7 +357,9 @@ pub fn sweep(
 ) -> Result<Vec<Row>, crate::run::RunError> {
     let variants = variants(base);
     let mut rows: Vec<Row> = Vec::new();
-    let mut reference: Option<(CurveMetrics, Vec<(f64, f64)>, f64)> = None;
+    // The reference's metrics, curve and wall time (the first run).
+    type Reference = (CurveMetrics, Vec<(f64, f64)>, f64);
+    let mut reference: Option<Reference> = None;
     for v in &variants {
         let dir = out.join("runs").join(v.slug());
         let (summary, curve) = crate::run::run_job(&v.job, &dir, workers)?;
