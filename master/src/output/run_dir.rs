@@ -58,7 +58,7 @@ pub struct RunSettings {
 }
 
 /// The summary, rewritten atomically after every step.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Default, Serialize)]
 pub struct Summary {
     /// The job's title.
     pub title: String,
@@ -130,18 +130,7 @@ impl RunWriter {
         let summary = Summary {
             title: settings.title.clone(),
             status: "running".into(),
-            steps: 0,
-            displacement: 0.0,
-            metrics: CurveMetrics::default(),
-            dem_steps: 0,
-            capped_relaxations: 0,
-            skipped_relaxations: 0,
-            linear_answers: 0,
-            max_error_bound: 0.0,
-            cuts: 0,
-            tolerated_steps: 0,
-            wall_seconds: 0.0,
-            workers: 0,
+            ..Summary::default()
         };
         let mut w = Self {
             dir: dir.to_path_buf(),
@@ -236,7 +225,7 @@ impl RunWriter {
             max_error_bound: old["max_error_bound"].as_f64().unwrap_or(0.0),
             tolerated_steps: count("tolerated_steps"),
             wall_seconds: before,
-            workers: 0,
+            ..Summary::default()
         };
         let started = Instant::now()
             .checked_sub(std::time::Duration::from_secs_f64(before.max(0.0)))
