@@ -325,6 +325,19 @@ pub enum TangentKind {
         /// Strain perturbation (default 1e-5 in the job file; must be > 0).
         strain: f64,
     },
+    /// `Paper` while fewer than `sliding` of the assembly's contacts slide, `Perturbation`
+    /// from there on: the contact-stiffness tangent is right while the contacts stick and too
+    /// stiff once the assembly slips and softens, where the perturbation tangent follows it.
+    /// Only the sliding assemblies pay the twelve extra relaxations (scene B: the band, not
+    /// the 400 points). The choice depends on the assembly's own relaxed state only, so it is
+    /// the same whatever worker holds the assembly.
+    Adaptive {
+        /// Sliding fraction (sliding contacts / contacts) from which the perturbation tangent
+        /// is used, in [0, 1].
+        sliding: f64,
+        /// Strain perturbation of the perturbation tangent (> 0).
+        strain: f64,
+    },
 }
 
 /// Most discs one assembly may hold (a cap so that a typo in `side` or `radius`, or a hostile
@@ -498,8 +511,15 @@ impl AssemblySpec {
                 }
             }
         }
-        if let TangentKind::Perturbation { strain } = &self.tangent {
-            positive("tangent.strain", *strain)?;
+        match &self.tangent {
+            TangentKind::Perturbation { strain } => positive("tangent.strain", *strain)?,
+            TangentKind::Adaptive { sliding, strain } => {
+                positive("tangent.strain", *strain)?;
+                if !(0.0..=1.0).contains(sliding) {
+                    return Err(invalid("tangent.sliding", sliding, "must be in [0, 1]"));
+                }
+            }
+            TangentKind::Paper | TangentKind::SlidingAware => {}
         }
         Ok(())
     }

@@ -138,3 +138,37 @@ fn kinetic_criterion_and_warm_start() {
         r_base.diagnostics.steps
     );
 }
+
+/// The adaptive tangent is the paper tangent while the contacts stick and the perturbation
+/// tangent once at least `sliding` of them slide, decided on the relaxed state. Checked
+/// exactly (same arithmetic, so bit-equal): an isotropic compression slides no contact, so
+/// `adaptive` answers the paper tangent with the paper's step count; a threshold of 0 always
+/// perturbs; a frictionless cell (mu_s = 0) sheared by 1e-3 slides most of its loaded
+/// contacts (as in `extremes.rs`), so a threshold of 0.05 perturbs there.
+#[test]
+fn adaptive_tangent_switches_where_contacts_slide() {
+    let solve = |tangent: TangentKind, mu: f64, target: &cosdem_common::MacroDeformation| {
+        let mut spec = hex_spec(0.1, penalty());
+        if let cosdem_worker::spec::TangentialModel::Coulomb { mu_s, .. } =
+            &mut spec.contact.tangential
+        {
+            *mu_s = mu;
+        }
+        spec.tangent = tangent;
+        Assembly::new(&spec).unwrap().solve(target).unwrap()
+    };
+    let adaptive = |sliding| TangentKind::Adaptive { sliding, strain: 1e-6 };
+    let pert = TangentKind::Perturbation { strain: 1e-6 };
+    let iso = iso(-1e-3);
+    let paper = solve(TangentKind::Paper, 0.5, &iso);
+    assert_eq!(paper.diagnostics.sliding_fraction, 0.0);
+    let sticking = solve(adaptive(0.05), 0.5, &iso);
+    assert_eq!(sticking.tangent, paper.tangent);
+    assert_eq!(sticking.diagnostics.steps, paper.diagnostics.steps);
+    assert_eq!(solve(adaptive(0.0), 0.5, &iso).tangent, solve(pert.clone(), 0.5, &iso).tangent);
+    let shear = grad([[0.0, 1e-3], [0.0, 0.0]]);
+    let slipping = solve(adaptive(0.05), 0.0, &shear);
+    assert!(slipping.diagnostics.sliding_fraction >= 0.05, "{:?}", slipping.diagnostics);
+    assert_eq!(slipping.tangent, solve(pert, 0.0, &shear).tangent);
+    assert_ne!(slipping.tangent, solve(TangentKind::Paper, 0.0, &shear).tangent);
+}

@@ -30,6 +30,13 @@ fn bad_specs_name_the_field() {
     assert!(err_of(&s).contains("density"));
 
     let mut s = hex_spec(0.1, penalty());
+    s.tangent = cosdem_worker::TangentKind::Adaptive { sliding: 1.5, strain: 1e-5 };
+    let e = err_of(&s);
+    assert!(e.contains("tangent.sliding") && e.contains("1.5"), "{e}");
+    s.tangent = cosdem_worker::TangentKind::Adaptive { sliding: 0.05, strain: 0.0 };
+    assert!(err_of(&s).contains("tangent.strain"));
+
+    let mut s = hex_spec(0.1, penalty());
     s.packing = PackingSpec::Random {
         r_min: 0.004,
         r_max: 0.002,
