@@ -50,9 +50,10 @@ enum Command {
         #[command(subcommand)]
         what: StudyWhat,
     },
-    /// Draw the PNG figures of a run directory into RUN_DIR/plots/.
+    /// Draw the PNG figures of a run directory (or of an RVE-size study directory) into
+    /// RUN_DIR/plots/.
     Plot {
-        /// The run directory (holds curve.csv).
+        /// The run directory (holds curve.csv), or a study directory (holds study.json).
         run_dir: PathBuf,
     },
     /// Benchmarks of the coupling (see `cosdem_master::bench`): printed figures.
@@ -285,6 +286,10 @@ struct RveSizeArgs {
     /// Output directory (default `runs/<job stem>-rve-size`).
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Reuse the curves already in `OUT/curves/` (a study continued or assembled from runs
+    /// made elsewhere): a size whose curve file exists is read, not run again.
+    #[arg(long)]
+    reuse: bool,
 }
 
 #[derive(clap::Args)]
@@ -412,6 +417,7 @@ fn study(what: StudyWhat) -> Result<()> {
         radius: a.radius,
         tolerance: a.tolerance,
         threads: a.threads,
+        reuse: a.reuse,
         ..RveSizeSettings::default()
     };
     println!("RVE-size study: {} sizes -> {}", settings.sizes.len(), dir.display());
@@ -622,6 +628,17 @@ fn run(args: RunArgs) -> Result<()> {
 
 /// Draws the figures of a run directory; an error if any figure failed (after trying all).
 fn plot(dir: &Path) -> Result<()> {
+    if dir.join("study.json").is_file() && !dir.join("curve.csv").is_file() {
+        // An RVE-size study directory (`cosdem study rve-size`).
+        let study = cosdem_master::study::read_study(dir)?;
+        let title = dir.file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned());
+        let failed = cosdem_master::study::plot_study(&study, dir, &title);
+        for (what, e) in &failed {
+            eprintln!("plot failed: {what}: {e}");
+        }
+        println!("study plots in {}", dir.join("plots").display());
+        return Ok(());
+    }
     let report = cosdem_master::output::plot::plot_run(dir)?;
     println!("{} plots in {}", report.written.len(), dir.join("plots").display());
     for (what, e) in &report.failed {

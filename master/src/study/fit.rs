@@ -43,7 +43,7 @@ pub enum FitError {
 }
 
 /// A value with its 95 % confidence interval (`None` when there is none).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, serde::Deserialize)]
 pub struct Estimate {
     /// Best estimate.
     pub value: f64,
@@ -68,7 +68,7 @@ impl Estimate {
 }
 
 /// The fitted size law of one property.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
 pub struct SizeLawFit {
     /// Exponent `k` of V.
     pub k: i32,

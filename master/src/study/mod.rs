@@ -40,16 +40,26 @@ pub struct RveSizeSettings {
     pub threads: usize,
     /// Upper end of the linear range for E (m); the paper's 0.01.
     pub linear_range: f64,
+    /// Read a size's curve from `curves/curve_<V>.csv` when that file exists instead of
+    /// running it again ([`reused_size`]).
+    pub reuse: bool,
 }
 
 impl Default for RveSizeSettings {
     fn default() -> Self {
-        Self { sizes: Vec::new(), radius: None, tolerance: 0.01, threads: 0, linear_range: 0.01 }
+        Self {
+            sizes: Vec::new(),
+            radius: None,
+            tolerance: 0.01,
+            threads: 0,
+            linear_range: 0.01,
+            reuse: false,
+        }
     }
 }
 
 /// One run of the study.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
 pub struct SizeRun {
     /// Assembly size V (m^2).
     pub size: f64,
@@ -72,7 +82,7 @@ pub struct SizeRun {
 }
 
 /// The fit of one property, or why there is none.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
 #[serde(untagged)]
 pub enum FitOutcome {
     /// The fitted law.
@@ -85,7 +95,7 @@ pub enum FitOutcome {
 }
 
 /// The whole study (also `study.json`).
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
 pub struct RveSizeStudy {
     /// Tolerance defining V^cr.
     pub tolerance: f64,
@@ -145,6 +155,9 @@ pub fn job_for_size(job: &Job, size: f64, radius: Option<f64>) -> Result<Job> {
 /// Collects the curve of one run and writes it.
 struct Curve {
     shortening: f64,
+    /// Reaction multiplier of a symmetric mesh (2 for a half or quarter: the reaction of the
+    /// kept part of `load_set` is half the platen force).
+    load_scale: f64,
     load_set: String,
     points: Vec<(f64, f64)>,
     dem_steps: u64,
@@ -154,7 +167,7 @@ struct Curve {
 impl StepObserver for Curve {
     fn on_step(&mut self, r: &StepReport, view: &SolutionView<'_>) -> Result<()> {
         let d = r.load_factor * self.shortening;
-        let load = -r.reactions.get(&self.load_set).map_or(0.0, |x| x[1]);
+        let load = -self.load_scale * r.reactions.get(&self.load_set).map_or(0.0, |x| x[1]);
         let dem: u64 = view.gauss_points.iter().map(|g| g.diagnostics.steps).sum();
         self.dem_steps += dem;
         self.points.push((d, load));
@@ -192,6 +205,7 @@ pub fn run_size(
     };
     let mut obs = Curve {
         shortening: job.shortening(),
+        load_scale: job.load_scale(),
         load_set: job.loading.load_set.clone(),
         points: Vec::new(),
         dem_steps: 0,
@@ -211,6 +225,64 @@ pub fn run_size(
         metrics: CurveMetrics::from_curve(&obs.points, settings.linear_range),
         dem_steps: obs.dem_steps,
         wall_seconds: t0.elapsed().as_secs_f64(),
+        status,
+    })
+}
+
+/// The run of size `size` rebuilt from its curve file `curve` (columns `step, displacement,
+/// load, dem_steps`, as [`run_size`] writes them): the metrics and DEM steps from the curve,
+/// the disc count from the packing; status `finished` when the curve reaches the job's
+/// displacement, else `incomplete: ...`. The wall time of a reused run is unknown (0).
+pub fn reused_size(
+    job: &Job,
+    size: f64,
+    settings: &RveSizeSettings,
+    curve: &Path,
+) -> Result<SizeRun> {
+    let job = job_for_size(job, size, settings.radius)?;
+    let MaterialSection::Dem { assembly } = &job.material else { unreachable!("checked") };
+    let bad = |m: String| Error::Observer(format!("{}: {m}", curve.display()));
+    let text = std::fs::read_to_string(curve).map_err(|e| bad(e.to_string()))?;
+    let (mut points, mut dem_steps) = (Vec::new(), 0u64);
+    for (i, line) in text.lines().enumerate().skip(1).filter(|(_, l)| !l.trim().is_empty()) {
+        let cells: Vec<&str> = line.split(',').collect();
+        let num = |c: usize| cells.get(c).and_then(|v| v.trim().parse::<f64>().ok());
+        match (num(1), num(2), num(3)) {
+            (Some(d), Some(f), Some(n)) => {
+                points.push((d, f));
+                dem_steps += n as u64;
+            }
+            _ => {
+                return Err(bad(format!(
+                    "line {}: expected step,displacement,load,dem_steps",
+                    i + 1
+                )));
+            }
+        }
+    }
+    let reached = points.last().map_or(0.0, |p| p.0);
+    let target = job.shortening();
+    let status = if reached >= target * (1.0 - 1e-9) {
+        "finished".to_string()
+    } else {
+        format!("incomplete: the reused curve ends at {reached} m of {target} m")
+    };
+    let radius = match assembly.packing {
+        PackingSpec::Hexagonal { radius, .. } => radius,
+        PackingSpec::Random { r_max, ref radii, .. } => radii.iter().copied().fold(r_max, f64::max),
+    };
+    let discs = cosdem_worker::Assembly::new(assembly)
+        .map_err(|e| bad(format!("packing: {e}")))?
+        .disc_count();
+    Ok(SizeRun {
+        size,
+        side: size.sqrt(),
+        radius,
+        discs,
+        steps: points.len() as u64,
+        metrics: CurveMetrics::from_curve(&points, settings.linear_range),
+        dem_steps,
+        wall_seconds: 0.0,
         status,
     })
 }
@@ -274,14 +346,80 @@ pub fn rve_size(job: &Job, settings: &RveSizeSettings, dir: &Path) -> Result<Rve
             .par_iter()
             .map(|&v| {
                 let path: PathBuf = curves.join(format!("curve_{}.csv", fmt_f64(v)));
-                run_size(job, v, settings, Some(&path))
+                if settings.reuse && path.is_file() {
+                    reused_size(job, v, settings, &path)
+                } else {
+                    run_size(job, v, settings, Some(&path))
+                }
             })
             .collect()
     });
     let runs = runs.into_iter().collect::<Result<Vec<_>>>()?;
     let study = fit_runs(runs, settings.tolerance);
     write_study(&study, dir)?;
+    for (figure, e) in plot_study(&study, dir, &job.title) {
+        tracing::warn!(figure, error = %e, "study figure not drawn");
+    }
     Ok(study)
+}
+
+/// Draws the study's figures into `dir/plots/`: `curves.png` (every size's load-displacement
+/// curve, Fig. 3) and `size_<property>.png` (F_u, F_res, E, E50 against V with the fitted law,
+/// Figs. 4-5). Returns the figures that could not be drawn (a property without values, e.g.
+/// no F_res before a peak) with why; none of them stops the study.
+pub fn plot_study(
+    study: &RveSizeStudy,
+    dir: &Path,
+    title: &str,
+) -> Vec<(String, crate::output::plot::PlotError)> {
+    use crate::output::plot::study::{plot_size_law, plot_study_curves};
+    use crate::output::plot::{PlotError, curve::read_curve};
+    let plots = dir.join("plots");
+    let mut failed = Vec::new();
+    if let Err(e) = std::fs::create_dir_all(&plots) {
+        let err = PlotError::NoData { path: plots.clone(), message: e.to_string() };
+        return vec![("plots".into(), err)];
+    }
+    let mut curves = Vec::new();
+    for r in &study.runs {
+        let path = dir.join("curves").join(format!("curve_{}.csv", fmt_f64(r.size)));
+        match read_curve(&path) {
+            Ok(c) => curves.push((r.size, c)),
+            Err(e) => failed.push((path.display().to_string(), e)),
+        }
+    }
+    if let Err(e) = plot_study_curves(&curves, title, &plots.join("curves.png")) {
+        failed.push(("curves.png".into(), e));
+    }
+    let properties: [(&str, &str, &str, &FitOutcome, fn(&CurveMetrics) -> Option<f64>); 4] = [
+        ("peak_load", "F_u", "N/m", &study.peak_load, |m| {
+            (m.peak_load > 0.0).then_some(m.peak_load)
+        }),
+        ("residual_load", "F_res", "N/m", &study.residual_load, |m| m.residual_load),
+        ("stiffness", "E", "N/m per m", &study.stiffness, |m| m.stiffness),
+        ("stiffness_50", "E50", "N/m per m", &study.stiffness_50, |m| m.stiffness_50),
+    ];
+    for (file, name, unit, fit, value) in properties {
+        let points: Vec<(f64, f64)> =
+            study.runs.iter().filter_map(|r| value(&r.metrics).map(|x| (r.size, x))).collect();
+        let fit = match fit {
+            FitOutcome::Fitted(f) => Some(f.as_ref()),
+            FitOutcome::Failed { .. } => None,
+        };
+        let figure = format!("size_{file}.png");
+        if let Err(e) = plot_size_law(&points, fit, name, unit, &plots.join(&figure)) {
+            failed.push((figure, e));
+        }
+    }
+    failed
+}
+
+/// Reads a study's `study.json` back (for redrawing its figures).
+pub fn read_study(dir: &Path) -> Result<RveSizeStudy> {
+    let path = dir.join("study.json");
+    let text = std::fs::read_to_string(&path)
+        .map_err(|e| Error::Observer(format!("{}: {e}", path.display())))?;
+    serde_json::from_str(&text).map_err(|e| Error::Observer(format!("{}: {e}", path.display())))
 }
 
 /// Writes `study.csv` and `study.json`.

@@ -54,7 +54,14 @@ fn three_tiny_sizes_run_deterministically_and_write_files() {
         assert!(x.metrics.peak_load > 0.0);
     }
     assert!(a.runs[0].discs < a.runs[1].discs && a.runs[1].discs < a.runs[2].discs);
-    for f in ["study.csv", "study.json", "curves/curve_0.0025.csv"] {
+    for f in [
+        "study.csv",
+        "study.json",
+        "curves/curve_0.0025.csv",
+        "plots/curves.png",
+        "plots/size_peak_load.png",
+        "plots/size_stiffness.png",
+    ] {
         assert!(d1.join(f).is_file(), "{f}");
     }
     let csv = std::fs::read_to_string(d1.join("study.csv")).unwrap();
@@ -64,6 +71,14 @@ fn three_tiny_sizes_run_deterministically_and_write_files() {
     // Three points: F_u and E fit exactly (no intervals), or say why not.
     let json = std::fs::read_to_string(d1.join("study.json")).unwrap();
     assert!(json.contains("peak_load") && json.contains("stiffness_50"), "{json}");
+    // study.json reads back into the same study (what `cosdem plot DIR` redraws from).
+    assert_eq!(read_study(&d1).unwrap().runs, a.runs);
+    // Reusing the curves gives the same runs but for the (unknown) wall time.
+    let reuse = RveSizeSettings { reuse: true, ..one.clone() };
+    let c = rve_size(&job, &reuse, &d1).unwrap();
+    for (x, y) in a.runs.iter().zip(&c.runs) {
+        assert_eq!(SizeRun { wall_seconds: 0.0, ..x.clone() }, *y);
+    }
     std::fs::remove_dir_all(&d1).unwrap();
     std::fs::remove_dir_all(&d2).unwrap();
 }
@@ -84,4 +99,27 @@ fn bad_sizes_and_materials_are_errors_naming_the_value() {
     );
     let job = Job::from_toml(&elastic, "e").unwrap();
     assert!(job_for_size(&job, 0.01, None).unwrap_err().to_string().contains("dem"));
+}
+
+/// A symmetric mesh reports the whole panel's load: the half mesh (`symmetry = "half_x"`, two
+/// elements in x so the axis is a mesh line) gives the full mesh's F_u and E. The half mesh is
+/// the full problem restricted to symmetric fields, so the curves agree to the Newton
+/// tolerance (5e-3 relative residual here; 1e-7 measured on scene A), not to round-off;
+/// without the load scale they would differ by a factor 2.
+#[test]
+fn symmetric_meshes_report_the_whole_panel_load() {
+    let full = JOB.replace("nx = 1", "nx = 2");
+    let half = full.replace("nx = 2", "nx = 2\n    symmetry = \"half_x\"");
+    let settings = RveSizeSettings { sizes: vec![0.0025], threads: 1, ..Default::default() };
+    let run = |toml: &str| {
+        let job = Job::from_toml(toml, "sym").unwrap();
+        run_size(&job, 0.0025, &settings, None).unwrap()
+    };
+    let (f, h) = (run(&full), run(&half));
+    assert_eq!(f.status, "finished");
+    assert_eq!(h.status, "finished");
+    let rel = |a: f64, b: f64| (a - b).abs() / b.abs();
+    assert!(rel(h.metrics.peak_load, f.metrics.peak_load) < 1e-2, "{h:?} vs {f:?}");
+    let (hs, fs) = (h.metrics.stiffness.unwrap(), f.metrics.stiffness.unwrap());
+    assert!(rel(hs, fs) < 1e-2, "E {hs} vs {fs}");
 }

@@ -20,6 +20,8 @@ pub mod curve;
 pub mod field;
 /// Figs. 10-12: force chains and fluctuation arrows of one assembly.
 pub mod particles;
+/// Figs. 3-5 of the RVE-size study: curves per size, properties against the size.
+pub mod study;
 
 use super::OutputError;
 use super::field_data::FieldData;
