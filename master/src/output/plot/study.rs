@@ -179,9 +179,20 @@ pub fn plot_size_law(
                 });
         }
     }
+    // The legend goes where the points are not: top right over a property that falls with V,
+    // bottom right under one that rises.
+    let by_v = |a: &&(f64, f64), b: &&(f64, f64)| a.0.total_cmp(&b.0);
+    let falls = match (points.iter().min_by(by_v), points.iter().max_by(by_v)) {
+        (Some(first), Some(last)) => first.1 > last.1,
+        _ => false,
+    };
     chart
         .configure_series_labels()
-        .position(SeriesLabelPosition::LowerRight)
+        .position(if falls {
+            SeriesLabelPosition::UpperRight
+        } else {
+            SeriesLabelPosition::LowerRight
+        })
         .label_font((FONT, 17))
         .background_style(WHITE.mix(0.9))
         .border_style(BLACK.mix(0.5))
