@@ -118,7 +118,12 @@ fn listen(args: cosdem_worker::service::ListenArgs) -> Result<()> {
         .init();
     let config: WorkerConfig = args.try_into()?;
     let runtime = tokio::runtime::Builder::new_multi_thread().enable_all().build()?;
-    runtime.block_on(serve(config, Dem, shutdown_signal()))?;
+    // The signal handlers are installed before the port is bound (see `shutdown_signal`).
+    let shutdown = {
+        let _guard = runtime.enter();
+        shutdown_signal()
+    };
+    runtime.block_on(serve(config, Dem, shutdown))?;
     Ok(())
 }
 

@@ -29,9 +29,11 @@ async fn main() -> Result<(), Box<dyn std::error::Error>> {
         hang_after_solves: args.hang_after,
         hang_for: Duration::from_secs(args.hang_secs),
     });
+    // Handlers first: the test may send SIGTERM as soon as it reads the address.
+    let shutdown = shutdown_signal();
     let listener = bind(&config).await?;
     println!("LISTENING {}", listener.local_addr()?);
     std::io::stdout().flush()?;
-    serve_listener(listener, config, model, shutdown_signal()).await?;
+    serve_listener(listener, config, model, shutdown).await?;
     Ok(())
 }

@@ -135,25 +135,38 @@ pub async fn serve_duplex<M: MicroModel>(
         .map_err(|e| ServiceError::Transport(e.to_string()))
 }
 
-/// Resolves on SIGTERM or Ctrl-C: the shutdown future a worker binary passes to [`serve`].
-pub async fn shutdown_signal() {
-    let ctrl_c = async {
-        let _ = tokio::signal::ctrl_c().await;
-    };
-    #[cfg(unix)]
-    let term = async {
-        match tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate()) {
-            Ok(mut s) => {
+/// Registers the SIGTERM and SIGINT (Ctrl-C) handlers now and returns the future that
+/// resolves on either: the shutdown future a worker binary passes to [`serve`]. Registering
+/// eagerly, before the listener is bound, matters: a handler installed only when the future is
+/// first polled leaves a window after the port accepts connections in which SIGTERM kills the
+/// worker (the default action) instead of draining it. Call it inside a Tokio runtime.
+#[cfg(unix)]
+pub fn shutdown_signal() -> impl Future<Output = ()> + Send + 'static {
+    use tokio::signal::unix::{Signal, SignalKind, signal};
+    let term = signal(SignalKind::terminate()).ok();
+    let int = signal(SignalKind::interrupt()).ok();
+    let wait = |s: Option<Signal>| async move {
+        match s {
+            Some(mut s) => {
                 s.recv().await;
             }
-            Err(_) => std::future::pending::<()>().await,
+            None => std::future::pending::<()>().await,
         }
     };
-    #[cfg(not(unix))]
-    let term = std::future::pending::<()>();
-    tokio::select! {
-        _ = ctrl_c => {},
-        _ = term => {},
+    async move {
+        tokio::select! {
+            _ = wait(term) => {},
+            _ = wait(int) => {},
+        }
+        tracing::info!("shutdown requested: draining");
     }
-    tracing::info!("shutdown requested: draining");
+}
+
+/// Resolves on Ctrl-C (no SIGTERM off Unix).
+#[cfg(not(unix))]
+pub fn shutdown_signal() -> impl Future<Output = ()> + Send + 'static {
+    async {
+        let _ = tokio::signal::ctrl_c().await;
+        tracing::info!("shutdown requested: draining");
+    }
 }
