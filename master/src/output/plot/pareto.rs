@@ -185,8 +185,14 @@ fn draw_panel(
     let (x0, x1) = log_range(drawable.iter().map(|&i| panel.points[i].x), 1.6, (0.1, 10.0));
     let (y0, y1) =
         log_range(drawable.iter().filter_map(|&i| pct(&panel.points[i])), 2.0, (1e-3, 100.0));
-    // Room above the highest point for the legend (upper right).
-    let y1 = y1 * 8.0;
+    // Room above the highest point for the legend (upper right); the lower ends down to a
+    // power of ten, where plotters starts its log-axis ticks.
+    let y1 = y1 * 4.0;
+    let decade = |v: f64| {
+        let d = 10f64.powf(v.log10().floor());
+        if v / d < 3.0 { d } else { v }
+    };
+    let (x0, y0) = (decade(x0), decade(y0));
     let floor = y0 * 1.6;
     let y_of = |p: &ParetoPoint| pct(p).map(|e| if e > 0.0 { e } else { floor });
 
