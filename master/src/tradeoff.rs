@@ -300,9 +300,14 @@ pub fn variants(base: &Job) -> Vec<Variant> {
             }
         }
     }
-    if let PackingSpec::Random { side, .. } = a.packing {
+    if let PackingSpec::Random { side, r_max, ref radii, .. } = a.packing {
+        // The worker refuses a side below four largest diameters.
+        let largest = radii.iter().copied().fold(r_max, f64::max);
         for f in [0.5, 0.75] {
-            let s = side * f;
+            let s = (side * f).max(8.0 * largest);
+            if s >= side {
+                continue;
+            }
             v.push(with(base, "assembly.side", format!("{s:.3}"), move |j| {
                 if let Some(a) = assembly_mut(j)
                     && let PackingSpec::Random { side, .. } = &mut a.packing
