@@ -103,7 +103,8 @@ pub const EXCLUSIVE: &[&[&str]] =
 /// Committed RVE-size study fits (`cosdem study rve-size`), each `(name, JSON)` in the format
 /// of [`SizeFit`]. A fit applies to a job whose assembly equals the study's but for the side
 /// and the speed knobs.
-pub const SIZE_FITS: &[(&str, &str)] = &[];
+pub const SIZE_FITS: &[(&str, &str)] =
+    &[("docs/rve-size-scene-a.json", include_str!("../../docs/rve-size-scene-a.json"))];
 
 /// Why no plan could be made.
 #[derive(Debug, thiserror::Error)]
@@ -361,14 +362,23 @@ pub struct LawParams {
     pub a: f64,
     /// `b*` (1/m^(2k)).
     pub b_star: f64,
+    /// Upper end of the 95 % interval of `b*` (`None` without an interval).
+    pub b_star_high: Option<f64>,
 }
 
 impl LawParams {
-    /// `|F(V) / F^cr - 1| = |exp(a exp(b* V^k)) - 1|`; `None` when the law has no plateau
-    /// (`b* >= 0`: F^cr is then no representative value) or the value is not finite.
+    /// True when the fit establishes a plateau: `b* < 0` with its whole 95 % interval below
+    /// 0. Otherwise the sizes have not reached the plateau and `F^cr` is no representative
+    /// value (the study reports huge intervals then).
+    pub fn has_plateau(&self) -> bool {
+        self.b_star < 0.0 && self.b_star_high.is_some_and(|h| h < 0.0)
+    }
+
+    /// `|F(V) / F^cr - 1| = |exp(a exp(b* V^k)) - 1|`; `None` without an established plateau
+    /// ([`LawParams::has_plateau`]) or when the value is not finite.
     pub fn size_error(&self, v: f64) -> Option<f64> {
         let e = ((self.a * (self.b_star * v.powi(self.k)).exp()).exp() - 1.0).abs();
-        (self.b_star < 0.0 && e.is_finite()).then_some(e)
+        (self.has_plateau() && e.is_finite()).then_some(e)
     }
 }
 
@@ -486,10 +496,27 @@ fn size_report(
     } else {
         String::new()
     };
+    let mut unusable = Vec::new();
+    for (name, p) in [("F_u", fit.peak_load), ("F_res", fit.residual_load), ("E", fit.stiffness)] {
+        match p {
+            None => unusable.push(format!("{name}: not fitted")),
+            Some(p) if !p.has_plateau() => unusable.push(format!(
+                "{name}: no plateau established (b* = {:.3e}, 95 % interval up to {})",
+                p.b_star,
+                p.b_star_high.map_or("unknown".into(), |h| format!("{h:.3e}"))
+            )),
+            Some(_) => {}
+        }
+    }
+    let unusable = if unusable.is_empty() {
+        String::new()
+    } else {
+        format!(" (not predicted: {})", unusable.join("; "))
+    };
     let note = format!(
-        "V = {volume:.4e} m^2; size law of {} predicts |F(V)/F^cr - 1| = {}{range}; the \
-         assembly size is kept as written (not part of the promise, which is against a tight \
-         run of the same V)",
+        "V = {volume:.4e} m^2; size law of {} predicts |F(V)/F^cr - 1| = {}{unusable}{range}; \
+         the assembly size is kept as written (not part of the promise, which is against a \
+         tight run of the same V)",
         fit.source,
         predicted.describe()
     );
@@ -955,6 +982,12 @@ mod tests {
     fn size_error_from_a_matching_fit() {
         let job = quick(Some(0.05));
         let trade = Trade::measured().unwrap();
+        // The committed fit (quick scene, pre-peak) matches the quick job, but its sizes did
+        // not reach a plateau: it is found and says why it predicts nothing.
+        let committed = tune(&job).unwrap().unwrap();
+        assert_eq!(committed.report.size.fit.as_deref().map(|f| f.contains("quick")), Some(true));
+        assert!(committed.report.size.note.contains("no plateau established"));
+        assert_eq!(committed.report.size.predicted.unwrap().peak, None);
         let none = plan(&job, &trade, &[]).unwrap().unwrap();
         assert!(none.report.size.fit.is_none());
         assert!(none.report.size.note.contains("no committed RVE-size study fit"));
@@ -963,7 +996,7 @@ mod tests {
             source: "made up".into(),
             assembly: assembly(&job).clone(),
             sizes: vec![0.005, 0.01, 0.02],
-            peak_load: Some(LawParams { k: 2, a: -0.2, b_star: -100.0 }),
+            peak_load: Some(LawParams { k: 2, a: -0.2, b_star: -100.0, b_star_high: Some(-50.0) }),
             residual_load: None,
             stiffness: None,
         };
@@ -973,7 +1006,13 @@ mod tests {
         assert!((e - expect).abs() < 1e-15 && (e - 0.1797).abs() < 1e-4, "{e}");
         assert!(p.report.warnings.iter().any(|w| w.contains("assembly size alone")));
         // No plateau (b* >= 0): no size error.
-        assert_eq!(LawParams { k: 1, a: -0.2, b_star: 5.0 }.size_error(0.01), None);
+        assert_eq!(
+            LawParams { k: 1, a: -0.2, b_star: 5.0, b_star_high: None }.size_error(0.01),
+            None
+        );
+        // b* < 0 but its interval reaches above 0: not established either.
+        let open = LawParams { k: 1, a: -0.2, b_star: -5.0, b_star_high: Some(3.0) };
+        assert_eq!(open.size_error(0.01), None);
         assert_eq!(assembly(&p.job).packing, assembly(&job).packing);
         // Another contact law: the fit does not apply.
         let mut other = fit;
