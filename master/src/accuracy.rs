@@ -450,11 +450,11 @@ fn knob_value(job: &Job, knob: &str) -> String {
             Driver::Cundall { alpha } => format!("cundall (alpha {alpha})"),
             Driver::Fire { .. } => "fire".into(),
         },
-        "tangent" => match a.tangent {
-            TangentKind::Paper => "paper".into(),
-            TangentKind::SlidingAware => "sliding_aware".into(),
-            TangentKind::Perturbation { strain } => format!("perturbation (strain {strain})"),
-        },
+        // The job file's name of the kind (serde), so a new tangent kind needs no change here.
+        "tangent" => serde_json::to_value(&a.tangent)
+            .ok()
+            .and_then(|v| v.get("kind").and_then(|k| k.as_str()).map(str::to_string))
+            .unwrap_or_else(|| format!("{:?}", a.tangent)),
         "warm_start" => a.warm_start.to_string(),
         _ => "-".into(),
     }

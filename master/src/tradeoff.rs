@@ -480,7 +480,7 @@ pub fn read_csv(text: &str, origin: &str) -> Result<Vec<Row>, TableError> {
 /// Moves one knob of `job` to a setting of the sweep, named as in the table: `load_step`
 /// `x2`/`x4` (any `xF`: the load step times F), `relaxation.tolerance`, `relaxation.safety`,
 /// `relaxation.density_scale` (numbers), `relaxation.driver` `fire`/`cundall`, `tangent`
-/// `sliding_aware`/`paper`, `warm_start` `true`/`false`, `assembly.side` (m). The same moves
+/// `sliding_aware`/`paper`/`perturbation` (strain 1e-5), `warm_start` `true`/`false`, `assembly.side` (m). The same moves
 /// as [`variants`] (a test checks they agree). An analytical material has only the load step.
 pub fn apply_setting(job: &mut Job, knob: &str, setting: &str) -> Result<(), TableError> {
     let unknown =
@@ -507,6 +507,7 @@ pub fn apply_setting(job: &mut Job, knob: &str, setting: &str) -> Result<(), Tab
         ("relaxation.driver", "cundall") => a.relaxation.driver = Driver::default(),
         ("tangent", "sliding_aware") => a.tangent = TangentKind::SlidingAware,
         ("tangent", "paper") => a.tangent = TangentKind::Paper,
+        ("tangent", "perturbation") => a.tangent = TangentKind::Perturbation { strain: 1e-5 },
         ("warm_start", "true") => a.warm_start = true,
         ("warm_start", "false") => a.warm_start = false,
         ("assembly.side", _) => {
