@@ -480,8 +480,9 @@ pub fn read_csv(text: &str, origin: &str) -> Result<Vec<Row>, TableError> {
 /// Moves one knob of `job` to a setting of the sweep, named as in the table: `load_step`
 /// `x2`/`x4` (any `xF`: the load step times F), `relaxation.tolerance`, `relaxation.safety`,
 /// `relaxation.density_scale` (numbers), `relaxation.driver` `fire`/`cundall`, `tangent`
-/// `sliding_aware`/`paper`/`perturbation` (strain 1e-5), `warm_start` `true`/`false`, `assembly.side` (m). The same moves
-/// as [`variants`] (a test checks they agree). An analytical material has only the load step.
+/// `sliding_aware`/`paper`/`perturbation` (strain 1e-5), `warm_start` `true`/`false`,
+/// `assembly.side` (m). The same moves as [`variants`] (a test checks they agree). An
+/// analytical material has only the load step.
 pub fn apply_setting(job: &mut Job, knob: &str, setting: &str) -> Result<(), TableError> {
     let unknown =
         || TableError::UnknownSetting { knob: knob.to_string(), setting: setting.to_string() };
