@@ -27,6 +27,12 @@ pub struct Job {
     /// Free text shown in the summary.
     #[serde(default)]
     pub title: String,
+    /// Accuracy target (fraction in (0, 1), e.g. 0.05 for 5 %): when given, the speed knobs
+    /// of `[material.assembly]` and the load step are chosen by [`crate::accuracy`] from the
+    /// measured speed/accuracy trade before the run. Absent (the default): the job runs as
+    /// written.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub accuracy: Option<f64>,
     /// The macro mesh.
     pub mesh: MeshSection,
     /// Boundary conditions, loads and load steps.
@@ -551,6 +557,18 @@ impl Job {
                 "in [1e-12, 1]",
             ));
         }
+        if let Some(a) = self.accuracy {
+            if !(a > 0.0 && a < 1.0) {
+                return Err(bad("accuracy", a, "must be a fraction in (0, 1), e.g. 0.05 for 5 %"));
+            }
+            if matches!(self.material, MaterialSection::Elastic { .. }) {
+                return Err(bad(
+                    "accuracy",
+                    a,
+                    "needs [material] kind = \"dem\": the measured trade is of DEM settings",
+                ));
+            }
+        }
         for &d in &self.output.field_plots_at {
             if !(d.is_finite() && d >= 0.0) {
                 return Err(bad("output.field_plots_at", d, "must be finite and >= 0 (m)"));
@@ -750,6 +768,22 @@ mod tests {
         let text = MINIMAL.replace("nx = 2", "nx = 0");
         let err = Job::from_toml(&text, "j").unwrap_err().to_string();
         assert!(err.contains("mesh.nx"), "{err}");
+    }
+
+    /// `accuracy` is optional, a fraction in (0, 1), and only for DEM jobs; errors name the
+    /// key and the value.
+    #[test]
+    fn accuracy_key_is_validated() {
+        assert_eq!(Job::from_toml(MINIMAL, "j").unwrap().accuracy, None);
+        let quick = include_str!("../../examples/quick.toml");
+        let with = |a: &str| format!("accuracy = {a}\n{quick}");
+        assert_eq!(Job::from_toml(&with("0.05"), "j").unwrap().accuracy, Some(0.05));
+        for bad in ["0.0", "1.0", "-0.1", "5", "nan"] {
+            let err = Job::from_toml(&with(bad), "j").unwrap_err().to_string();
+            assert!(err.contains("accuracy") && err.contains("(0, 1)"), "{bad}: {err}");
+        }
+        let err = Job::from_toml(&format!("accuracy = 0.05\n{MINIMAL}"), "j").unwrap_err();
+        assert!(err.to_string().contains("accuracy") && err.to_string().contains("dem"), "{err}");
     }
 
     #[test]

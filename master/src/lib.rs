@@ -33,6 +33,9 @@
 //! # Ok::<(), cosdem_master::Error>(())
 //! ```
 
+/// Accuracy target: the cheapest speed settings the measured trade predicts to stay within
+/// a job's `accuracy` (what was picked and why: `RUN/accuracy.json`).
+pub mod accuracy;
 /// From nodal fields to Gauss-point kinematics and back to global residual and tangent.
 pub mod assembly;
 /// Benchmarks of the coupling (RPC overhead, worker scaling, FE versus DEM cost): `cosdem bench`.

@@ -31,6 +31,18 @@ pub enum RunError {
     /// The assembly specification could not be encoded.
     #[error("assembly spec: {0}")]
     Spec(#[from] serde_json::Error),
+    /// The accuracy target could not be turned into settings.
+    #[error(transparent)]
+    Accuracy(#[from] crate::accuracy::AccuracyError),
+}
+
+/// The job to run: `job` itself (unchanged, bit for bit) when it has no `accuracy` key, else
+/// the settings [`crate::accuracy::tune`] picks for the target, with its report.
+pub fn tuned(job: &Job) -> Result<(Job, Option<crate::accuracy::Report>), RunError> {
+    Ok(match crate::accuracy::tune(job)? {
+        None => (job.clone(), None),
+        Some(plan) => (plan.job, Some(plan.report)),
+    })
 }
 
 /// Where the DEM assemblies are solved.
@@ -120,13 +132,22 @@ pub fn material_for(
 /// early (a step that cannot be cut further, a failed worker) still returns its summary, with
 /// `status = "failed: ..."` and the steps it finished: the curve so far is what the caller
 /// judges. Only errors before the first step (the job, the pool, the output directory) are
-/// returned as `Err`.
+/// returned as `Err`. A job with `accuracy` runs with the settings [`tuned`] picks, and its
+/// report is written to `dir/accuracy.json` and logged.
 pub fn run_job(
     job: &Job,
     dir: &Path,
     workers: &WorkerChoice,
 ) -> Result<(Summary, Vec<(f64, f64)>), RunError> {
+    let (job, report) = tuned(job)?;
+    let job = &job;
     let mut writer = RunWriter::create(dir, run_settings(job))?;
+    if let Some(report) = &report {
+        report.write(dir)?;
+        for line in report.lines() {
+            tracing::info!("{line}");
+        }
+    }
     let mut solver = Solver::new(job.model()?, job.solver_settings()?)?;
     let ids = gauss_point_ids(&solver);
     let (mut material, n) = material_for(job, workers, &ids, None)?;

@@ -11,6 +11,8 @@
 //! are tested without running anything.
 
 use crate::job::{Job, MaterialSection};
+use crate::output::plot::Result as PlotResult;
+use crate::output::plot::pareto::{ParetoPanel, ParetoPoint, PointRole, plot_pareto};
 use crate::post::CurveMetrics;
 use cosdem_worker::spec::{Driver, PackingSpec, TangentKind};
 use serde::Serialize;
@@ -87,6 +89,19 @@ impl Errors {
         let all = [self.peak, self.residual, self.stiffness];
         all.iter().try_fold(0.0f64, |m, e| e.map(|e| m.max(e)))
     }
+
+    /// The largest of the errors that exist, `None` only when none does. This is what the
+    /// Pareto front and plot rank by: a sweep whose reference never passes a peak has no F_res
+    /// in any row, and [`Errors::worst`] would then leave every row off the front. A value is
+    /// missing for every row alike when the reference lacks it; a finished row that lacks a
+    /// value the reference has (no peak passed where the reference passed one) is ranked on
+    /// the rest, so read its F_res column before trusting its place on the front.
+    pub fn worst_present(&self) -> Option<f64> {
+        [self.peak, self.residual, self.stiffness, self.curve]
+            .into_iter()
+            .flatten()
+            .reduce(f64::max)
+    }
 }
 
 fn relative(value: Option<f64>, reference: Option<f64>) -> Option<f64> {
@@ -148,10 +163,26 @@ pub fn compare(
     }
 }
 
+/// True when the row's run reached its end (`status == "finished"`).
+pub fn finished(row: &Row) -> bool {
+    row.status == "finished"
+}
+
 /// Indices of the rows on the Pareto front of (wall time, worst error): no other row is both
-/// faster and more accurate. Rows without a worst error are never on the front.
+/// faster and more accurate. See [`pareto_front_by`].
 pub fn pareto_front(rows: &[Row]) -> Vec<usize> {
-    let key = |r: &Row| r.errors.worst().map(|e| (r.wall_seconds, e));
+    pareto_front_by(rows, |r| r.wall_seconds)
+}
+
+/// Indices of the rows on the Pareto front of (`cost`, worst error): no other row is both
+/// cheaper and more accurate. The error is [`Errors::worst_present`] (the largest of the
+/// errors the row has). Only finished rows take part: a run that stopped early is neither a
+/// choice nor a yardstick, however fast it failed.
+pub fn pareto_front_by(rows: &[Row], cost: impl Fn(&Row) -> f64) -> Vec<usize> {
+    let key = |r: &Row| {
+        let c = cost(r);
+        r.errors.worst_present().filter(|_| finished(r) && c.is_finite()).map(|e| (c, e))
+    };
     let mut front = Vec::new();
     for (i, r) in rows.iter().enumerate() {
         let Some((t, e)) = key(r) else { continue };
@@ -280,9 +311,14 @@ pub fn variants(base: &Job) -> Vec<Variant> {
             }
         }
     }
-    if let PackingSpec::Random { side, .. } = a.packing {
+    if let PackingSpec::Random { side, r_max, ref radii, .. } = a.packing {
+        // The worker refuses a side below four largest diameters.
+        let largest = radii.iter().copied().fold(r_max, f64::max);
         for f in [0.5, 0.75] {
-            let s = side * f;
+            let s = (side * f).max(8.0 * largest);
+            if s >= side {
+                continue;
+            }
             v.push(with(base, "assembly.side", format!("{s:.3}"), move |j| {
                 if let Some(a) = assembly_mut(j)
                     && let PackingSpec::Random { side, .. } = &mut a.packing
@@ -356,9 +392,208 @@ pub fn csv(rows: &[Row]) -> String {
     s
 }
 
+/// Why a sweep table could not be read, or a setting not applied.
+#[derive(Debug, thiserror::Error)]
+pub enum TableError {
+    /// The CSV is malformed (missing column, unreadable number).
+    #[error("{origin}: {message}")]
+    Csv {
+        /// The file (or a name for embedded text).
+        origin: String,
+        /// What is wrong, naming the line and the column.
+        message: String,
+    },
+    /// A (knob, setting) pair that [`apply_setting`] does not know.
+    #[error("unknown setting {knob} = {setting}")]
+    UnknownSetting {
+        /// The knob.
+        knob: String,
+        /// The setting.
+        setting: String,
+    },
+}
+
+/// Reads back a `tradeoff.csv` written by [`csv`] (columns found by name). The metrics
+/// keep what the CSV has (F_u, F_res, E; not the peak's displacement nor E50).
+pub fn read_csv(text: &str, origin: &str) -> Result<Vec<Row>, TableError> {
+    let err = |message: String| TableError::Csv { origin: origin.to_string(), message };
+    let mut lines = text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty());
+    let header: Vec<&str> =
+        lines.next().map(|(_, l)| l.split(',').map(str::trim).collect()).unwrap_or_default();
+    let col = |name: &str| {
+        header.iter().position(|h| *h == name).ok_or_else(|| err(format!("no column {name:?}")))
+    };
+    let c = [
+        "knob",
+        "setting",
+        "status",
+        "displacement",
+        "wall_seconds",
+        "speedup",
+        "dem_steps",
+        "cuts",
+        "peak_load",
+        "residual_load",
+        "stiffness",
+        "err_peak",
+        "err_residual",
+        "err_stiffness",
+        "err_curve",
+    ]
+    .map(col);
+    let [knob, setting, status, disp, wall, speedup, dem, cuts, pk, res, stiff, ep, er, es, ec] = c;
+    let (knob, setting, status, disp, wall, speedup, dem, cuts) =
+        (knob?, setting?, status?, disp?, wall?, speedup?, dem?, cuts?);
+    let (pk, res, stiff, ep, er, es, ec) = (pk?, res?, stiff?, ep?, er?, es?, ec?);
+    let mut rows = Vec::new();
+    for (i, line) in lines {
+        let cells: Vec<&str> = line.split(',').map(str::trim).collect();
+        let cell = |c: usize| {
+            cells.get(c).copied().ok_or_else(|| {
+                err(format!("line {}: {} cells, column {} missing", i + 1, cells.len(), c + 1))
+            })
+        };
+        let num = |c: usize| -> Result<f64, TableError> {
+            let v = cell(c)?;
+            v.parse::<f64>().map_err(|_| {
+                err(format!("line {}: column {:?} is not a number: {v:?}", i + 1, header[c]))
+            })
+        };
+        let opt = |c: usize| -> Result<Option<f64>, TableError> {
+            if cell(c)?.is_empty() { Ok(None) } else { num(c).map(Some) }
+        };
+        rows.push(Row {
+            knob: cell(knob)?.to_string(),
+            setting: cell(setting)?.to_string(),
+            status: cell(status)?.to_string(),
+            displacement: num(disp)?,
+            wall_seconds: num(wall)?,
+            dem_steps: num(dem)? as u64,
+            cuts: num(cuts)? as u64,
+            metrics: CurveMetrics {
+                peak_load: num(pk)?,
+                residual_load: opt(res)?,
+                stiffness: opt(stiff)?,
+                ..CurveMetrics::default()
+            },
+            errors: Errors {
+                peak: opt(ep)?,
+                residual: opt(er)?,
+                stiffness: opt(es)?,
+                curve: opt(ec)?,
+            },
+            speedup: num(speedup)?,
+        });
+    }
+    Ok(rows)
+}
+
+/// Moves one knob of `job` to a setting of the sweep, named as in the table: `load_step`
+/// `x2`/`x4` (any `xF`: the load step times F), `relaxation.tolerance`, `relaxation.safety`,
+/// `relaxation.density_scale` (numbers), `relaxation.driver` `fire`/`cundall`, `tangent`
+/// `sliding_aware`/`paper`/`perturbation` (strain 1e-5), `warm_start` `true`/`false`,
+/// `assembly.side` (m). The same moves as [`variants`] (a test checks they agree). An
+/// analytical material has only the load step.
+pub fn apply_setting(job: &mut Job, knob: &str, setting: &str) -> Result<(), TableError> {
+    let unknown =
+        || TableError::UnknownSetting { knob: knob.to_string(), setting: setting.to_string() };
+    let number = || setting.parse::<f64>().ok().filter(|v| v.is_finite() && *v > 0.0);
+    if knob == "load_step" {
+        let f = setting.strip_prefix('x').and_then(|f| f.parse::<f64>().ok());
+        let f = f.filter(|f| f.is_finite() && *f > 0.0).ok_or_else(unknown)?;
+        if let Some(inc) = &mut job.loading.increment {
+            *inc *= f;
+        } else {
+            job.loading.steps = ((job.loading.steps as f64 / f).round() as usize).max(1);
+        }
+        return Ok(());
+    }
+    let a = assembly_mut(job).ok_or_else(unknown)?;
+    match (knob, setting) {
+        ("relaxation.tolerance", _) => a.relaxation.tolerance = number().ok_or_else(unknown)?,
+        ("relaxation.safety", _) => a.relaxation.safety = number().ok_or_else(unknown)?,
+        ("relaxation.density_scale", _) => {
+            a.relaxation.density_scale = number().ok_or_else(unknown)?;
+        }
+        ("relaxation.driver", "fire") => a.relaxation.driver = Driver::fire(),
+        ("relaxation.driver", "cundall") => a.relaxation.driver = Driver::default(),
+        ("tangent", "sliding_aware") => a.tangent = TangentKind::SlidingAware,
+        ("tangent", "paper") => a.tangent = TangentKind::Paper,
+        ("tangent", "perturbation") => a.tangent = TangentKind::Perturbation { strain: 1e-5 },
+        ("warm_start", "true") => a.warm_start = true,
+        ("warm_start", "false") => a.warm_start = false,
+        ("assembly.side", _) => {
+            let s = number().ok_or_else(unknown)?;
+            match &mut a.packing {
+                PackingSpec::Hexagonal { side, .. } | PackingSpec::Random { side, .. } => {
+                    *side = s;
+                }
+            }
+        }
+        _ => return Err(unknown()),
+    }
+    Ok(())
+}
+
+/// The role of a row in the plot.
+fn role(r: &Row) -> PointRole {
+    match r.knob.as_str() {
+        "reference" => PointRole::Reference,
+        "default" => PointRole::Default,
+        _ if !finished(r) => PointRole::Failed,
+        _ => PointRole::Other,
+    }
+}
+
+/// The label of a row in the plot (`tolerance=1e-3`: the `relaxation.` prefix dropped).
+fn point_label(r: &Row) -> String {
+    match r.knob.as_str() {
+        "reference" => "reference (tight)".into(),
+        "default" => "default (job as given)".into(),
+        k => {
+            let k = k.strip_prefix("relaxation.").unwrap_or(k);
+            let failed = if finished(r) { "" } else { " (failed)" };
+            format!("{k}={}{failed}", r.setting)
+        }
+    }
+}
+
+/// The Pareto plot's panels of a sweep: worst error (see [`Errors::worst_present`]) against
+/// wall time, and against DEM steps (left out when no row has any, e.g. an elastic job).
+pub fn pareto_panels(rows: &[Row]) -> Vec<ParetoPanel> {
+    let panel = |x_label: &str, cost: &dyn Fn(&Row) -> f64| ParetoPanel {
+        x_label: x_label.to_string(),
+        points: rows
+            .iter()
+            .map(|r| ParetoPoint {
+                label: point_label(r),
+                x: cost(r),
+                error: r.errors.worst_present(),
+                role: role(r),
+            })
+            .collect(),
+        front: pareto_front_by(rows, cost),
+    };
+    let mut panels = vec![panel("Wall time (s)", &|r: &Row| r.wall_seconds)];
+    if rows.iter().any(|r| r.dem_steps > 0) {
+        panels.push(panel("DEM steps", &|r: &Row| r.dem_steps as f64));
+    }
+    panels
+}
+
+/// Draws the Pareto plot of a sweep (see [`pareto_panels`]) into `path` (PNG).
+pub fn write_pareto(rows: &[Row], title: &str, path: &std::path::Path) -> PlotResult<()> {
+    plot_pareto(&pareto_panels(rows), title, path)
+}
+
+/// The Pareto plot's file name in a sweep's directory.
+pub const PARETO_FILE: &str = "pareto.png";
+
 /// Runs the sweep of `base` into `out` (one run directory per variant under `out/runs/`),
-/// rewriting `out/tradeoff.csv` and `out/tradeoff.md` after every run so a long sweep can be
-/// read as it goes. `progress` hears each finished row. The reference runs first.
+/// rewriting `out/tradeoff.csv`, `out/tradeoff.md` and `out/pareto.png` after every run so a
+/// long sweep can be read as it goes. `progress` hears each finished row. The reference runs
+/// first. The job's `accuracy` key, if any, is dropped: it would move the very knobs the
+/// sweep measures.
 pub fn sweep(
     base: &Job,
     title: &str,
@@ -366,7 +601,9 @@ pub fn sweep(
     workers: &crate::run::WorkerChoice,
     mut progress: impl FnMut(&Row),
 ) -> Result<Vec<Row>, crate::run::RunError> {
-    let variants = variants(base);
+    let mut base = base.clone();
+    base.accuracy = None;
+    let variants = variants(&base);
     let mut rows: Vec<Row> = Vec::new();
     // The reference's metrics, curve and wall time (the first run).
     type Reference = (CurveMetrics, Vec<(f64, f64)>, f64);
@@ -396,6 +633,10 @@ pub fn sweep(
         };
         write("tradeoff.csv", csv(&rows))?;
         write("tradeoff.md", markdown(title, &rows))?;
+        // A figure that cannot be drawn is a warning, never a failed sweep.
+        if let Err(e) = write_pareto(&rows, title, &out.join(PARETO_FILE)) {
+            tracing::warn!(error = %e, "pareto plot not written");
+        }
     }
     Ok(rows)
 }
@@ -444,10 +685,99 @@ mod tests {
     fn pareto_front_drops_dominated_rows() {
         let rows = vec![row(10.0, 0.0), row(5.0, 0.02), row(6.0, 0.03), row(1.0, 0.2)];
         assert_eq!(pareto_front(&rows), vec![0, 1, 3]);
-        let mut missing = row(0.5, 0.0);
+        // A row without F_res is ranked on the errors it has (here 0.01 < 0.02: it beats
+        // row 1 and joins the front), and a failed row never takes part.
+        let mut missing = row(4.0, 0.01);
         missing.errors.residual = None;
-        let rows = vec![row(10.0, 0.0), missing];
-        assert_eq!(pareto_front(&rows), vec![0]);
+        let mut failed = row(0.1, 0.0);
+        failed.status = "failed: step 3".into();
+        let rows = vec![row(10.0, 0.0), row(5.0, 0.02), missing, failed];
+        assert_eq!(pareto_front(&rows), vec![0, 2]);
+        // By DEM steps instead of wall time: row 1 is now the cheapest.
+        let by_steps = pareto_front_by(&rows, |r| if r.wall_seconds == 5.0 { 1.0 } else { 9.0 });
+        assert_eq!(by_steps, vec![0, 1]);
+    }
+
+    /// The worst present error ignores missing values; with none present there is none.
+    #[test]
+    fn worst_present_is_the_largest_existing_error() {
+        let e = Errors { peak: Some(0.01), residual: None, stiffness: Some(0.03), curve: None };
+        assert_eq!(e.worst(), None);
+        assert_eq!(e.worst_present(), Some(0.03));
+        assert_eq!(Errors::default().worst_present(), None);
+    }
+
+    /// The committed sweeps read back: every row, the failed one included, and a non-empty
+    /// Pareto front although no row has F_res (the table used to have an empty column).
+    #[test]
+    fn committed_tables_read_back_with_a_front() {
+        for (name, text) in [
+            ("tradeoff-scene-a.csv", include_str!("../../docs/tradeoff-scene-a.csv")),
+            ("tradeoff-scene-a-0.06.csv", include_str!("../../docs/tradeoff-scene-a-0.06.csv")),
+        ] {
+            let rows = read_csv(text, name).unwrap();
+            assert_eq!(rows.len(), 15, "{name}");
+            assert_eq!(rows[0].knob, "reference");
+            assert_eq!(rows[0].errors.peak, Some(0.0));
+            assert!(rows.iter().all(|r| r.errors.residual.is_none()), "{name}");
+            assert_eq!(rows.iter().filter(|r| !finished(r)).count(), 1, "{name}");
+            let front = pareto_front(&rows);
+            assert!(front.contains(&0), "{name}: the reference (zero error) is on the front");
+            assert!(front.len() >= 2, "{name}: {front:?}");
+            assert!(front.iter().all(|&i| finished(&rows[i])));
+            // Writing and reading again gives the same rows (up to the CSV's precision).
+            let again = read_csv(&csv(&rows), name).unwrap();
+            assert_eq!(again.len(), rows.len());
+            for (a, b) in rows.iter().zip(&again) {
+                assert_eq!((&a.knob, &a.setting, &a.status), (&b.knob, &b.setting, &b.status));
+                assert_eq!(a.dem_steps, b.dem_steps);
+                assert_eq!(a.errors, b.errors);
+            }
+        }
+        let e = read_csv("knob,setting\nx,y\n", "t").unwrap_err().to_string();
+        assert!(e.contains("status"), "{e}");
+    }
+
+    /// The Pareto plot of a committed sweep is drawn (two panels) with ink on it.
+    #[test]
+    fn pareto_plot_of_a_committed_sweep() {
+        let rows = read_csv(include_str!("../../docs/tradeoff-scene-a.csv"), "t").unwrap();
+        let panels = pareto_panels(&rows);
+        assert_eq!(panels.len(), 2);
+        assert_eq!(panels[0].points.len(), rows.len());
+        let dir = std::env::temp_dir().join(format!("cosdem-pareto-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("pareto.png");
+        write_pareto(&rows, "test", &path).unwrap();
+        let img = image::open(&path).unwrap().to_rgb8();
+        let ink = img.pixels().filter(|p| p.0 != [255, 255, 255]).count();
+        assert!(ink > 10_000, "only {ink} non-white pixels");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// `apply_setting` makes the same job as the sweep's variant of that setting.
+    #[test]
+    fn apply_setting_agrees_with_the_variants() {
+        let job = Job::from_toml(include_str!("../../examples/quick.toml"), "examples/quick.toml")
+            .unwrap();
+        let side = |j: &mut Job| match &mut assembly_mut(j).unwrap().packing {
+            PackingSpec::Hexagonal { side, .. } | PackingSpec::Random { side, .. } => {
+                std::mem::replace(side, 0.0)
+            }
+        };
+        for v in &variants(&job)[2..] {
+            let mut j = job.clone();
+            apply_setting(&mut j, v.knob, &v.setting).unwrap();
+            let mut expect = v.job.clone();
+            // The side is printed to 3 decimals in the setting (0.1 * 0.75 = 0.07500000000000001).
+            let (a, b) = (side(&mut j), side(&mut expect));
+            assert!((a - b).abs() <= 5e-4, "{}: side {a} vs {b}", v.slug());
+            assert_eq!(j, expect, "{}", v.slug());
+        }
+        let mut j = job.clone();
+        assert!(apply_setting(&mut j, "tangent", "magic").is_err());
+        assert!(apply_setting(&mut j, "load_step", "x0").is_err());
+        assert!(apply_setting(&mut j, "relaxation.tolerance", "-1").is_err());
     }
 
     /// Metric errors are relative and missing values stay missing.
@@ -466,6 +796,7 @@ mod tests {
         assert_eq!(e.residual, None);
         assert!((e.stiffness.unwrap() - 0.1).abs() < 1e-12);
         assert_eq!(e.worst(), None);
+        assert!((e.worst_present().unwrap() - 0.1).abs() < 1e-12);
     }
 
     /// The sweep of a DEM job moves one knob at a time and keeps the scene.

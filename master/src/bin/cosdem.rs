@@ -6,6 +6,8 @@
 //!     [--pressure P] [--out DIR]
 //! cosdem study rve-size JOB.toml --sizes V1,V2,... [--radius R] [--out DIR]
 //! cosdem bench overhead|scaling|fe|all [OPTIONS]
+//! cosdem bench tradeoff JOB.toml [--displacement D] [--out DIR]
+//! cosdem bench tradeoff-plot DIR/tradeoff.csv [--out PNG] [--title T]
 //! cosdem plot RUN_DIR
 //! ```
 //! `run` checkpoints into `RUN/checkpoint.bin` (every `[output] checkpoint_every` steps);
@@ -79,6 +81,34 @@ enum BenchWhat {
     /// Speed against accuracy: sweep every speed knob of a job against a tight reference
     /// run; writes tradeoff.csv, tradeoff.md and one run directory per setting.
     Tradeoff(TradeoffArgs),
+    /// Redraw the Pareto plot of an existing tradeoff.csv without running anything, and print
+    /// its Markdown table (Pareto column filled).
+    TradeoffPlot(TradeoffPlotArgs),
+}
+
+#[derive(clap::Args)]
+struct TradeoffPlotArgs {
+    /// The sweep's CSV (written by `cosdem bench tradeoff`).
+    csv: PathBuf,
+    /// The PNG to write (default: pareto.png beside the CSV).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// The figure's title (default: "Speed against accuracy: <CSV>").
+    #[arg(long)]
+    title: Option<String>,
+}
+
+fn tradeoff_plot(a: TradeoffPlotArgs) -> Result<()> {
+    use cosdem_master::tradeoff::{PARETO_FILE, markdown, read_csv, write_pareto};
+    let text =
+        std::fs::read_to_string(&a.csv).with_context(|| format!("reading {}", a.csv.display()))?;
+    let rows = read_csv(&text, &a.csv.display().to_string())?;
+    let out = a.out.unwrap_or_else(|| a.csv.with_file_name(PARETO_FILE));
+    let title = a.title.unwrap_or_else(|| format!("Speed against accuracy: {}", a.csv.display()));
+    write_pareto(&rows, &title, &out)?;
+    print!("{}", markdown(&title, &rows));
+    eprintln!("{} rows -> {}", rows.len(), out.display());
+    Ok(())
 }
 
 #[derive(clap::Args)]
@@ -123,6 +153,12 @@ fn tradeoff(a: TradeoffArgs) -> Result<()> {
         );
     })?;
     println!("{} settings -> {}", rows.len(), out.join("tradeoff.md").display());
+    // The sweep redraws the plot after every row and only logs a failure: say it here.
+    let png = out.join(cosdem_master::tradeoff::PARETO_FILE);
+    match cosdem_master::tradeoff::write_pareto(&rows, &title, &png) {
+        Ok(()) => println!("Pareto plot -> {}", png.display()),
+        Err(e) => eprintln!("warning: Pareto plot: {e}"),
+    }
     Ok(())
 }
 
@@ -232,6 +268,7 @@ fn bench(what: BenchWhat) -> Result<()> {
             fe_versus_dem(a.elements, a.discs, a.iterations, a.repeats, out).map_err(e)
         }
         BenchWhat::Tradeoff(a) => tradeoff(a),
+        BenchWhat::TradeoffPlot(a) => tradeoff_plot(a),
         BenchWhat::All(c) => {
             overhead(&workload(400, 4, 10, &c)?, out).map_err(e)?;
             scaling(&workload(400, 64, 2, &c)?, out).map_err(e)?;
@@ -540,8 +577,18 @@ fn worker_choice(job: &Job, args: &RunArgs) -> Result<WorkerChoice> {
 fn run(args: RunArgs) -> Result<()> {
     let job = Job::load(&args.job)?;
     let dir = run_dir(&args, &job);
+    // `accuracy`: the settings picked for the target replace the job's (a pure function of
+    // the job, so a resume picks the same ones).
+    let (job, accuracy) = cosdem_master::run::tuned(&job)?;
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     init_logging(&dir, args.resume)?;
+    if let Some(report) = &accuracy {
+        report.write(&dir)?;
+        for line in report.lines() {
+            eprintln!("{line}");
+            tracing::info!("{line}");
+        }
+    }
     let checkpoint = if args.resume {
         let path = dir.join(checkpoint::FILE);
         let c = Checkpoint::read(&path)?;

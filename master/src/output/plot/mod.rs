@@ -8,6 +8,9 @@
 //! | `force_chains_eE_pP_NNNNN.png` | `snapshots/eE_pP/snap_NNNNN.vtu` | Figs. 10-11 |
 //! | `fluctuations_eE_pP_NNNNN.png` | the same snapshot | Fig. 12 |
 //!
+//! The Pareto plot of a speed/accuracy sweep (`cosdem bench tradeoff`, written beside its
+//! `tradeoff.csv`) is [`pareto::plot_pareto`].
+//!
 //! Each figure is a pure function of its input data ([`curve::plot_curve`],
 //! [`field::plot_strain_field`], [`particles::plot_force_chains`],
 //! [`particles::plot_fluctuations`]); [`plot_run`] finds the inputs in a run directory.
@@ -18,6 +21,8 @@
 pub mod curve;
 /// Fig. 9: the equivalent-strain field over the mesh.
 pub mod field;
+/// The Pareto plot of a speed/accuracy sweep (`cosdem bench tradeoff`).
+pub mod pareto;
 /// Figs. 10-12: force chains and fluctuation arrows of one assembly.
 pub mod particles;
 /// Figs. 3-5 of the RVE-size study: curves per size, properties against the size.
