@@ -363,6 +363,9 @@ pub fn rve_size(job: &Job, settings: &RveSizeSettings, dir: &Path) -> Result<Rve
     Ok(study)
 }
 
+/// One figure of [`plot_study`]: file stem, name, unit, fit, and the value of a run.
+type Property<'a> = (&'a str, &'a str, &'a str, &'a FitOutcome, fn(&CurveMetrics) -> Option<f64>);
+
 /// Draws the study's figures into `dir/plots/`: `curves.png` (every size's load-displacement
 /// curve, Fig. 3) and `size_<property>.png` (F_u, F_res, E, E50 against V with the fitted law,
 /// Figs. 4-5). Returns the figures that could not be drawn (a property without values, e.g.
@@ -391,7 +394,7 @@ pub fn plot_study(
     if let Err(e) = plot_study_curves(&curves, title, &plots.join("curves.png")) {
         failed.push(("curves.png".into(), e));
     }
-    let properties: [(&str, &str, &str, &FitOutcome, fn(&CurveMetrics) -> Option<f64>); 4] = [
+    let properties: [Property<'_>; 4] = [
         ("peak_load", "F_u", "N/m", &study.peak_load, |m| {
             (m.peak_load > 0.0).then_some(m.peak_load)
         }),
