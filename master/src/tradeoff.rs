@@ -342,6 +342,12 @@ fn pct(e: Option<f64>) -> String {
     e.map_or("-".into(), |e| format!("{:.2} %", 100.0 * e))
 }
 
+/// Whether `--skip` names the variant: by its knob (`relaxation.driver`) or its knob and
+/// setting (`relaxation.driver=fire`).
+pub fn skipped(v: &Variant, skip: &[String]) -> bool {
+    skip.iter().any(|s| *s == v.knob || *s == format!("{}={}", v.knob, v.setting))
+}
+
 /// The Markdown table of a sweep (rows in sweep order; Pareto-front rows marked with `*`).
 pub fn markdown(title: &str, rows: &[Row]) -> String {
     let front = pareto_front(rows);
@@ -606,11 +612,16 @@ pub fn sweep(
     title: &str,
     out: &std::path::Path,
     workers: &crate::run::WorkerChoice,
+    skip: &[String],
     mut progress: impl FnMut(&Row),
 ) -> Result<Vec<Row>, crate::run::RunError> {
     let mut base = base.clone();
     base.accuracy = None;
-    let variants = variants(&base);
+    let mut variants = variants(&base);
+    // The reference (first) is the yardstick of every row: never skipped.
+    let reference_variant = variants.remove(0);
+    variants.retain(|v| !skipped(v, skip));
+    variants.insert(0, reference_variant);
     let mut rows: Vec<Row> = Vec::new();
     // The reference's metrics, curve and wall time (the first run).
     type Reference = (CurveMetrics, Vec<(f64, f64)>, f64);
@@ -804,6 +815,22 @@ mod tests {
         assert!((e.stiffness.unwrap() - 0.1).abs() < 1e-12);
         assert_eq!(e.worst(), None);
         assert!((e.worst_present().unwrap() - 0.1).abs() < 1e-12);
+    }
+
+    /// `--skip` names a variant by knob or by knob=setting, nothing else.
+    #[test]
+    fn skip_by_knob_or_setting() {
+        let job = Job::from_toml(include_str!("../../examples/quick.toml"), "examples/quick.toml")
+            .unwrap();
+        let v = variants(&job);
+        let fire = v.iter().find(|v| v.setting == "fire").unwrap();
+        let x2 = v.iter().find(|v| v.knob == "load_step" && v.setting == "x2").unwrap();
+        let by_knob = ["relaxation.driver".to_string()];
+        assert!(skipped(fire, &by_knob) && !skipped(x2, &by_knob));
+        let by_setting = ["load_step=x4".to_string()];
+        assert!(!skipped(x2, &by_setting));
+        assert!(v.iter().any(|v| skipped(v, &by_setting)));
+        assert!(!skipped(fire, &[]));
     }
 
     /// The sweep of a DEM job moves one knob at a time and keeps the scene.

@@ -121,6 +121,10 @@ struct TradeoffArgs {
     /// Stop every run at this displacement (m) instead of the job's (a shorter sweep).
     #[arg(long)]
     displacement: Option<f64>,
+    /// Leave out these variants: a knob (`relaxation.driver`) or a knob=setting
+    /// (`relaxation.driver=fire`), comma-separated (e.g. a setting known to stall the scene).
+    #[arg(long, value_delimiter = ',')]
+    skip: Vec<String>,
 }
 
 fn tradeoff(a: TradeoffArgs) -> Result<()> {
@@ -138,7 +142,8 @@ fn tradeoff(a: TradeoffArgs) -> Result<()> {
         "knob", "setting", "wall s", "speedup", "F_u", "F_res", "E", "curve"
     );
     let pct = |e: Option<f64>| e.map_or("-".into(), |e| format!("{:.2}%", 100.0 * e));
-    let rows = cosdem_master::tradeoff::sweep(&job, &title, &out, &WorkerChoice::default(), |r| {
+    let workers = WorkerChoice::default();
+    let rows = cosdem_master::tradeoff::sweep(&job, &title, &out, &workers, &a.skip, |r| {
         println!(
             "{:<26} {:<14} {:>9.1} {:>7.2}x {:>8} {:>8} {:>8} {:>8} {}",
             r.knob,
