@@ -182,24 +182,36 @@ impl<O: StepObserver> StepObserver for Checkpointer<O> {
     }
 }
 
-/// A flag set by the first Ctrl-C (SIGINT); a second Ctrl-C exits at once with status 130.
-/// Listens on a thread of its own (a one-thread tokio runtime), so the solver is never
-/// interrupted mid-step.
+/// A flag set by the first Ctrl-C (SIGINT) or SIGTERM (what Slurm, Kubernetes and
+/// `docker stop` send before they kill); a second one exits at once with status 130. Listens on
+/// a thread of its own (a one-thread tokio runtime), so the solver is never interrupted
+/// mid-step: the run stops after the current step with its checkpoint written.
 pub fn ctrl_c_flag() -> std::io::Result<Arc<AtomicBool>> {
     let flag = Arc::new(AtomicBool::new(false));
     let rt = tokio::runtime::Builder::new_current_thread().enable_all().build()?;
+    // Registered here, before the run starts, not when the thread first polls.
+    #[cfg(unix)]
+    let mut term = {
+        let _guard = rt.enter();
+        tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())?
+    };
     let f = flag.clone();
     std::thread::Builder::new().name("cosdem-ctrl-c".into()).spawn(move || {
         rt.block_on(async move {
             loop {
-                if tokio::signal::ctrl_c().await.is_err() {
-                    return;
-                }
+                #[cfg(unix)]
+                let received = tokio::select! {
+                    r = tokio::signal::ctrl_c() => r.is_ok().then_some("Ctrl-C"),
+                    r = term.recv() => r.map(|()| "SIGTERM"),
+                };
+                #[cfg(not(unix))]
+                let received = tokio::signal::ctrl_c().await.is_ok().then_some("Ctrl-C");
+                let Some(what) = received else { return };
                 if f.swap(true, Ordering::SeqCst) {
-                    eprintln!("\nsecond Ctrl-C: exiting without waiting for the step");
+                    eprintln!("\nsecond {what}: exiting without waiting for the step");
                     std::process::exit(130);
                 }
-                eprintln!("\nCtrl-C: stopping after the current step (Ctrl-C again to quit now)");
+                eprintln!("\n{what}: stopping after the current step (again to quit now)");
             }
         });
     })?;

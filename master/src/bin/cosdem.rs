@@ -11,7 +11,7 @@
 //! cosdem plot RUN_DIR
 //! ```
 //! `run` checkpoints into `RUN/checkpoint.bin` (every `[output] checkpoint_every` steps);
-//! Ctrl-C stops after the current step (checkpoint written, status `interrupted`, exit code
+//! Ctrl-C or SIGTERM stops after the current step (checkpoint written, status `interrupted`, exit code
 //! 130) and `--resume` continues from the checkpoint.
 //! `plot` (re)draws the PNG figures of a run directory into `RUN_DIR/plots/`; `run` does it
 //! at its end (a figure that fails is a warning, never a failed run).
