@@ -11,8 +11,9 @@
 //! cosdem plot RUN_DIR
 //! ```
 //! `run` checkpoints into `RUN/checkpoint.bin` (every `[output] checkpoint_every` steps);
-//! Ctrl-C or SIGTERM stops after the current step (checkpoint written, status `interrupted`, exit code
-//! 130) and `--resume` continues from the checkpoint.
+//! Ctrl-C or SIGTERM stops after the current step (checkpoint written, status `interrupted`,
+//! exit code 1; a second one quits at once with 130) and `--resume` continues from the
+//! checkpoint.
 //! `plot` (re)draws the PNG figures of a run directory into `RUN_DIR/plots/`; `run` does it
 //! at its end (a figure that fails is a warning, never a failed run).
 //! `bench` prints the coupling benchmarks of `cosdem_master::bench` (build with `--release`;
