@@ -5,7 +5,7 @@ use crate::contact::rolling;
 use crate::error::{Error, Result};
 use crate::homogenize::{Homogenized, homogenize};
 use crate::integrate::{self, RelaxReport};
-use crate::spec::{BoundarySpec, TangentKind};
+use crate::spec::{BoundarySpec, RelaxationSpec, TangentKind};
 use cosdem_common::voigt::{KX, KY, N, XX, XY, YX, YY};
 use cosdem_common::{MacroDeformation, MicroDiagnostics, MicroResponse};
 use std::time::Instant;
@@ -93,9 +93,20 @@ impl Assembly {
     /// Jumps `st` affinely to `target` and relaxes it with tolerance `tol`.
     pub fn relax_to(
         &mut self,
+        st: State,
+        target: &MacroDeformation,
+        tol: f64,
+    ) -> Result<(State, RelaxReport)> {
+        self.relax_capped(st, target, tol, u64::MAX)
+    }
+
+    /// [`Assembly::relax_to`] with at most `max_steps` steps (and never more than the spec's).
+    fn relax_capped(
+        &mut self,
         mut st: State,
         target: &MacroDeformation,
         tol: f64,
+        max_steps: u64,
     ) -> Result<(State, RelaxReport)> {
         target.validate()?;
         self.predict(&mut st, target);
@@ -103,15 +114,15 @@ impl Assembly {
         let law = self.law;
         let pen = self.penalty(target);
         let sys = self.system(&law, pen.as_ref(), target);
-        let rep = integrate::relax(
-            &sys,
-            &mut st.dynamics,
-            &mut st.pairs,
-            &mut work,
-            &self.spec.relaxation,
-            self.dt,
-            tol,
-        );
+        let capped;
+        let spec = if max_steps < self.spec.relaxation.max_steps {
+            capped = RelaxationSpec { max_steps, ..self.spec.relaxation.clone() };
+            &capped
+        } else {
+            &self.spec.relaxation
+        };
+        let rep =
+            integrate::relax(&sys, &mut st.dynamics, &mut st.pairs, &mut work, spec, self.dt, tol);
         self.work = work;
         Ok((st, rep?))
     }
@@ -242,21 +253,6 @@ impl Assembly {
             }
         }
         Ok((c, steps))
-    }
-
-    /// [`Assembly::relax_to`] with at most `max_steps` steps.
-    fn relax_capped(
-        &mut self,
-        st: State,
-        target: &MacroDeformation,
-        tol: f64,
-        max_steps: u64,
-    ) -> Result<(State, RelaxReport)> {
-        let full = self.spec.relaxation.max_steps;
-        self.spec.relaxation.max_steps = max_steps.min(full);
-        let out = self.relax_to(st, target, tol);
-        self.spec.relaxation.max_steps = full;
-        out
     }
 }
 
