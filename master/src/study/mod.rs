@@ -179,6 +179,14 @@ impl StepObserver for Curve {
     }
 }
 
+/// The disc radius of a hexagonal packing, the largest of a random one.
+fn largest_radius(packing: &PackingSpec) -> f64 {
+    match packing {
+        PackingSpec::Hexagonal { radius, .. } => *radius,
+        PackingSpec::Random { r_max, radii, .. } => radii.iter().copied().fold(*r_max, f64::max),
+    }
+}
+
 /// Runs the job at one size; `curve` is where its curve is written (if any).
 pub fn run_size(
     job: &Job,
@@ -189,10 +197,7 @@ pub fn run_size(
     let t0 = Instant::now();
     let job = job_for_size(job, size, settings.radius)?;
     let MaterialSection::Dem { assembly } = &job.material else { unreachable!("checked") };
-    let radius = match assembly.packing {
-        PackingSpec::Hexagonal { radius, .. } => radius,
-        PackingSpec::Random { r_max, ref radii, .. } => radii.iter().copied().fold(r_max, f64::max),
-    };
+    let radius = largest_radius(&assembly.packing);
     let mut solver = Solver::new(job.model()?, job.solver_settings()?)?;
     let ids = crate::run::gauss_point_ids(&solver);
     let mut material = DirectDem::new(assembly, &ids)?;
@@ -267,10 +272,7 @@ pub fn reused_size(
     } else {
         format!("incomplete: the reused curve ends at {reached} m of {target} m")
     };
-    let radius = match assembly.packing {
-        PackingSpec::Hexagonal { radius, .. } => radius,
-        PackingSpec::Random { r_max, ref radii, .. } => radii.iter().copied().fold(r_max, f64::max),
-    };
+    let radius = largest_radius(&assembly.packing);
     let discs = cosdem_worker::Assembly::new(assembly)
         .map_err(|e| bad(format!("packing: {e}")))?
         .disc_count();
