@@ -24,9 +24,10 @@
 //! - **direct**: [`Assembly::solve`] + [`Assembly::commit`] in a plain loop on this thread
 //!   (the baseline, no RPC, no serialization);
 //! - **in-process**: [`Pool::in_process`] with one worker, one relaxation thread
-//!   (`PoolConfig::in_process_threads = 1`), reached over the in-memory duplex transport;
-//!   per iteration one `Material::evaluate` of all points (one `SolveBatch`) and one
-//!   `Material::commit` (which also ships every committed state back to the master);
+//!   (`PoolConfig::in_process_threads = 1`), its service called directly (no transport); per iteration one `Material::evaluate`
+//!   of all points (one `SolveBatch`) and one `Material::commit` (carried on the next
+//!   `SolveBatch`, or a call of its own every `export_every` commits, when it also ships the
+//!   committed states back to the master);
 //! - **tcp**: [`Pool::connect`] to one `cosdem-worker listen --threads 1` process spawned on
 //!   a free loopback port (a separate process: real sockets, real HTTP/2 framing).
 //!
@@ -319,16 +320,21 @@ fn single_thread_config() -> PoolConfig {
 /// One relaxation thread per worker; no rebalancing: the assemblies are identical, so the
 /// placement by disc count is already even, and timing noise on a loaded machine must not
 /// migrate assemblies in the middle of a measurement.
-fn bench_config(export_every: u64) -> PoolConfig {
-    PoolConfig { export_every, rebalance_threshold: f64::INFINITY, ..single_thread_config() }
+fn bench_config(w: &Workload) -> PoolConfig {
+    PoolConfig {
+        export_every: w.export_every,
+        defer_commits: w.defer_commits,
+        rebalance_threshold: f64::INFINITY,
+        ..single_thread_config()
+    }
 }
 
-fn in_process_pool(workers: usize, export_every: u64) -> BenchResult<Pool> {
-    Ok(Pool::in_process(workers, bench_config(export_every), |_| Dem)?)
+fn in_process_pool(workers: usize, w: &Workload) -> BenchResult<Pool> {
+    Ok(Pool::in_process(workers, bench_config(w), |_| Dem)?)
 }
 
-fn tcp_pool(procs: &WorkerProcesses, export_every: u64) -> BenchResult<Pool> {
-    Ok(Pool::connect(&procs.addresses, bench_config(export_every))?)
+fn tcp_pool(procs: &WorkerProcesses, w: &Workload) -> BenchResult<Pool> {
+    Ok(Pool::connect(&procs.addresses, bench_config(w))?)
 }
 
 fn check_same(label: &str, a: &Run, b: &Run) -> BenchResult<()> {
@@ -358,6 +364,8 @@ pub struct Workload {
     pub worker_bin: Option<PathBuf>,
     /// [`PoolConfig::export_every`] of the pools (1: every commit ships every state back).
     pub export_every: u64,
+    /// [`PoolConfig::defer_commits`] of the pools (false: every commit is a call of its own).
+    pub defer_commits: bool,
 }
 
 /// Figure 1: direct versus in-process pool versus TCP pool, one worker with one thread.
@@ -386,15 +394,10 @@ pub fn overhead(w: &Workload, out: &mut dyn Write) -> BenchResult<()> {
                     discs = n;
                     d
                 }
-                1 => run_pool(
-                    &mut in_process_pool(1, w.export_every)?,
-                    &spec,
-                    w.points,
-                    w.iterations,
-                )?,
+                1 => run_pool(&mut in_process_pool(1, w)?, &spec, w.points, w.iterations)?,
                 _ => {
                     let p = procs.as_ref().ok_or("no worker process")?;
-                    run_pool(&mut tcp_pool(p, w.export_every)?, &spec, w.points, w.iterations)?
+                    run_pool(&mut tcp_pool(p, w)?, &spec, w.points, w.iterations)?
                 }
             });
         }
@@ -433,8 +436,13 @@ pub fn overhead(w: &Workload, out: &mut dyn Write) -> BenchResult<()> {
         out,
         "RPC overhead: {} Gauss points x {} iterations of {discs}-disc hexagonal assemblies \
          ({steps_per_solve:.0} relaxation steps per solve), 1 worker x 1 thread, states exported \
-         every {} commits, {} repetitions; per Gauss point per iteration, median [min .. max]:",
-        w.points, w.iterations, w.export_every, w.repeats
+         every {} commits, commits {}, {} repetitions; per Gauss point per iteration, median \
+         [min .. max]:",
+        w.points,
+        w.iterations,
+        w.export_every,
+        if w.defer_commits { "carried on the next SolveBatch" } else { "sent as calls" },
+        w.repeats
     )?;
     writeln!(out, "  direct Assembly::solve : {} ms", Spread::of(&direct).show(1e3, 3))?;
     writeln!(
@@ -487,8 +495,8 @@ pub fn scaling(w: &Workload, out: &mut dyn Write) -> BenchResult<()> {
             let mut runs = Vec::new();
             for (k, n) in [1usize, 2].into_iter().enumerate() {
                 let mut pool = match procs {
-                    None => in_process_pool(n, w.export_every)?,
-                    Some(p) => tcp_pool(&p[k], w.export_every)?,
+                    None => in_process_pool(n, w)?,
+                    Some(p) => tcp_pool(&p[k], w)?,
                 };
                 if pool.live_workers() != n {
                     return Err(format!(
@@ -603,7 +611,9 @@ fn fit_line(x: &[f64], y: &[f64]) -> (f64, f64) {
 /// against the batch size, fitted by `a + b n`, splits it into the fixed cost per iteration
 /// (`a`: the SolveBatch and Commit round trips, thread hand-offs) and the cost per Gauss
 /// point (`b`: (de)serialization, one streamed message, one relaxation task). In-process
-/// over the duplex transport, and over loopback TCP to a worker served by this process.
+/// (the service called directly; and over the in-memory HTTP/2 duplex transport), and over
+/// loopback TCP to a worker served by this process; commits carried on the next SolveBatch
+/// (the default) and, for comparison, sent as calls of their own.
 pub fn rpc_floor(
     sizes: &[usize],
     iterations: u64,
@@ -611,13 +621,26 @@ pub fn rpc_floor(
     out: &mut dyn Write,
 ) -> BenchResult<()> {
     let tcp = LoopbackStandIn::start()?;
-    let config = PoolConfig { rebalance_threshold: f64::INFINITY, ..single_thread_config() };
     writeln!(
         out,
         "Coupling floor: stand-in assemblies with no work, 1 worker x 1 thread, evaluate + \
-         commit per iteration, {iterations} iterations x {repeats} repetitions, median [min .. max]:"
+         commit per iteration, {iterations} iterations x {repeats} repetitions, median [min .. max]; \
+         commits carried on the next SolveBatch (the default) and sent as calls of their own:"
     )?;
-    for transport in ["in-process", "tcp"] {
+    for (transport, defer_commits) in [
+        ("in-process", true),
+        ("in-process", false),
+        ("duplex", true),
+        ("tcp", true),
+        ("tcp", false),
+    ] {
+        let config = PoolConfig {
+            rebalance_threshold: f64::INFINITY,
+            defer_commits,
+            in_process_duplex: transport == "duplex",
+            ..single_thread_config()
+        };
+        let label = format!("{transport}{}", if defer_commits { "" } else { " (commit calls)" });
         let mut medians = Vec::new();
         for &n in sizes {
             let mut v = Vec::new();
@@ -633,7 +656,7 @@ pub fn rpc_floor(
             let s = Spread::of(&v);
             writeln!(
                 out,
-                "  {transport:<10} {n:>4} points: {} ms per iteration, {:.1} us per point",
+                "  {label:<26} {n:>4} points: {} ms per iteration, {:.1} us per point",
                 s.show(1e3, 3),
                 s.median / n as f64 * 1e6
             )?;
@@ -643,7 +666,7 @@ pub fn rpc_floor(
         let (a, b) = fit_line(&x, &medians);
         writeln!(
             out,
-            "  {transport:<10} fit: {:.3} ms fixed per iteration + {:.1} us per Gauss point",
+            "  {label:<26} fit: {:.3} ms fixed per iteration + {:.1} us per Gauss point",
             a * 1e3,
             b * 1e6
         )?;

@@ -17,8 +17,9 @@ pub mod to_proto;
 
 pub use from_proto::ConvertError;
 
-/// The protocol version a master and a worker must agree on at handshake.
-pub const PROTOCOL_VERSION: u32 = 1;
+/// The protocol version a master and a worker must agree on at handshake. 2: a SolveBatch
+/// may carry the commit of the previous step (a worker of protocol 1 would ignore it).
+pub const PROTOCOL_VERSION: u32 = 2;
 
 /// Default limit on one gRPC message, both directions (256 MiB): large assemblies'
 /// exported states and snapshots must pass.

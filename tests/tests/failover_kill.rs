@@ -3,22 +3,24 @@
 
 mod common;
 use common::*;
-use cosdem_master::pool::Pool;
+use cosdem_master::pool::{Pool, PoolConfig};
 
-#[test]
-fn killed_workers_are_replaced_and_results_are_bit_identical() {
+/// Kills worker 0 mid-step 2 and worker 1 after step 4's last iteration.
+fn kill_two(config: PoolConfig) {
     let reference = reference(100, 20);
     let mut procs: Vec<_> = (0..3).map(|_| WorkerProcess::start(&[], &[])).collect();
     let addrs: Vec<String> = procs.iter().map(|p| p.addr.to_string()).collect();
-    let mut pool = Pool::connect(&addrs, test_config()).unwrap();
+    let mut pool = Pool::connect(&addrs, config).unwrap();
     create(&mut pool, 100, 20);
     let trace = run_program(&mut pool, &mut |step, iteration| {
         // Mid-step: the next evaluation finds worker 0 gone.
         if (step, iteration) == (2, 1) {
             procs[0].kill();
         }
-        // After the last iteration of step 4: the commit finds worker 1 gone, its points
-        // are re-solved from their stored states elsewhere and committed there.
+        // After the last iteration of step 4: with commit calls, the commit finds worker 1
+        // gone and its points are re-solved from their stored states elsewhere and
+        // committed there; with carried commits, step 5's batch finds it gone and the
+        // restore replays the held commit from the history.
         if (step, iteration) == (4, 2) {
             procs[1].kill();
         }
@@ -28,6 +30,16 @@ fn killed_workers_are_replaced_and_results_are_bit_identical() {
     assert_eq!(stats.workers_lost, 2, "{stats:?}");
     assert!(stats.restored > 0 && stats.resolved > 0, "{stats:?}");
     assert_eq!(pool.live_workers(), 1);
+}
+
+#[test]
+fn killed_workers_are_replaced_and_results_are_bit_identical() {
+    kill_two(test_config());
+}
+
+#[test]
+fn killed_workers_are_replaced_with_commit_calls() {
+    kill_two(PoolConfig { defer_commits: false, ..test_config() });
 }
 
 #[test]

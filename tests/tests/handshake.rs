@@ -61,7 +61,7 @@ async fn handshake_and_health_answer_while_relaxations_run() {
     let mut busy = c.clone();
     let solving = tokio::spawn(async move {
         let mut s = busy
-            .solve_batch(pb::SolveBatchRequest { step: 1, iteration: 0, items })
+            .solve_batch(pb::SolveBatchRequest { step: 1, iteration: 0, items, commit: None })
             .await
             .unwrap()
             .into_inner();

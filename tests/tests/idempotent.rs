@@ -21,8 +21,11 @@ async fn solve(
             target: Some(MacroDeformation::from_strain(&[e, 0.0, 0.0, 0.0, 0.0, 0.0], 0.0).into()),
         })
         .collect();
-    let mut s =
-        c.solve_batch(pb::SolveBatchRequest { step, iteration, items }).await.unwrap().into_inner();
+    let mut s = c
+        .solve_batch(pb::SolveBatchRequest { step, iteration, items, commit: None })
+        .await
+        .unwrap()
+        .into_inner();
     let mut out = Vec::new();
     while let Some(r) = s.message().await.unwrap() {
         out.push(r);

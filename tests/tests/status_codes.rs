@@ -20,7 +20,7 @@ fn create(ids: Vec<pb::GaussPoint>, discs: u64) -> pb::CreateAssembliesRequest {
 }
 
 fn solve(items: Vec<pb::SolveItem>) -> pb::SolveBatchRequest {
-    pb::SolveBatchRequest { step: 1, iteration: 0, items }
+    pb::SolveBatchRequest { step: 1, iteration: 0, items, commit: None }
 }
 
 #[tokio::test]

@@ -98,6 +98,8 @@ enum Op {
         step: u64,
         iteration: u32,
         items: Vec<(Option<pb::GaussPoint>, Option<pb::MacroDeformation>)>,
+        /// A commit carried on the batch: (step, iteration, ids, export).
+        commit: Option<(u64, u32, Vec<pb::GaussPoint>, bool)>,
     },
     Commit {
         step: u64,
@@ -131,9 +133,18 @@ fn op() -> impl Strategy<Value = Op> {
             prop::collection::vec(
                 (prop::option::weighted(0.9, id()), prop::option::weighted(0.9, target())),
                 0..4
+            ),
+            prop::option::weighted(
+                0.3,
+                (step(), prop_oneof![Just(0u32), any::<u32>()], ids(), prop::bool::weighted(0.1))
             )
         )
-            .prop_map(|(step, iteration, items)| Op::Solve { step, iteration, items }),
+            .prop_map(|(step, iteration, items, commit)| Op::Solve {
+                step,
+                iteration,
+                items,
+                commit
+            }),
         3 => (step(), prop_oneof![Just(0u32), any::<u32>()], ids(), any::<bool>())
             .prop_map(|(step, iteration, ids, export)| Op::Commit { step, iteration, ids, export }),
         1 => ids().prop_map(Op::Rollback),
@@ -187,13 +198,19 @@ async fn apply(svc: &WorkerService<Dem>, op: Op) -> Result<(), TestCaseError> {
             let req = pb::CreateAssembliesRequest { ids, spec };
             check("CreateAssemblies", svc.create_assemblies(Request::new(req)).await)?;
         }
-        Op::Solve { step, iteration, items } => {
+        Op::Solve { step, iteration, items, commit } => {
             let items = items
                 .into_iter()
                 .map(|(id, target)| pb::SolveItem { id, target })
                 .collect::<Vec<_>>();
             let n = items.len();
-            let req = pb::SolveBatchRequest { step, iteration, items };
+            let commit = commit.map(|(step, iteration, ids, export_state)| pb::CommitRequest {
+                step,
+                iteration,
+                ids,
+                export_state,
+            });
+            let req = pb::SolveBatchRequest { step, iteration, items, commit };
             if let Some(mut stream) = check("SolveBatch", svc.solve_batch(Request::new(req)).await)?
             {
                 let mut got = 0;
@@ -346,9 +363,14 @@ fn hostile_requests_have_the_documented_statuses() {
         expect(c(create(vec![gp(0)], SMALL.as_bytes(), 14)).await, Code::AlreadyExists, "exists");
 
         let solve = |items: Vec<pb::SolveItem>| async {
-            svc.solve_batch(Request::new(pb::SolveBatchRequest { step: 1, iteration: 0, items }))
-                .await
-                .map(|_| ())
+            svc.solve_batch(Request::new(pb::SolveBatchRequest {
+                step: 1,
+                iteration: 0,
+                items,
+                commit: None,
+            }))
+            .await
+            .map(|_| ())
         };
         let ident = pb::MacroDeformation { f_xx: 1.0, f_yy: 1.0, ..Default::default() };
         let item = |id, t| pb::SolveItem { id: Some(id), target: Some(t) };

@@ -182,6 +182,10 @@ struct CommonArgs {
     /// Export the committed states every this many commits (the pool's `export_every`).
     #[arg(long, default_value_t = cosdem_master::pool::PoolConfig::default().export_every)]
     export_every: u64,
+    /// Send every commit as a call of its own instead of carrying it on the next SolveBatch
+    /// (the pool's `defer_commits = false`: the protocol-1 behaviour, for comparison).
+    #[arg(long)]
+    commit_calls: bool,
 }
 
 #[derive(clap::Args)]
@@ -256,6 +260,7 @@ fn workload(discs: usize, points: usize, iterations: u64, c: &CommonArgs) -> Res
         repeats: c.repeats,
         worker_bin,
         export_every: c.export_every,
+        defer_commits: !c.commit_calls,
     })
 }
 

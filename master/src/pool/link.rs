@@ -1,19 +1,43 @@
-//! One worker seen from the master: its channel (TCP or in-memory), handshake and calls.
-//! The only place in the master that touches prost types.
+//! One worker seen from the master: its transport (a TCP channel, or the in-process service
+//! called directly), handshake and calls. The only place in the master that touches prost
+//! types.
 
 use cosdem_common::micro::{AssemblyInfo, AssemblyRequest, AssemblyState};
 use cosdem_common::{GaussPointId, MacroDeformation, MicroResponse};
 use cosdem_proto::v1 as pb;
 use cosdem_proto::v1::micro_solver_client::MicroSolverClient;
 use cosdem_proto::{PROTOCOL_VERSION, from_proto, to_proto};
-use cosdem_worker::service::{AttachToken, Token};
+use cosdem_worker::service::{AttachToken, MicroModel, Token, WorkerConfig};
 use std::time::Duration;
+use tonic::body::Body;
 use tonic::service::interceptor::InterceptedService;
 use tonic::transport::{Channel, Endpoint};
 use tonic::{Code, Request, Status};
+use tower::ServiceExt;
+
+/// A transport failure (a concrete type: a boxed error here trips the compiler's
+/// higher-ranked lifetime check on the calls' `Send` futures).
+#[derive(Debug)]
+pub struct TransportError(Box<dyn std::error::Error + Send + Sync>);
+
+impl std::fmt::Display for TransportError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.0.fmt(f)
+    }
+}
+
+impl std::error::Error for TransportError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        Some(&*self.0)
+    }
+}
+
+/// What carries a worker's calls: an HTTP/2 channel, or the in-process service itself.
+pub type Transport =
+    tower::util::BoxCloneSyncService<http::Request<Body>, http::Response<Body>, TransportError>;
 
 /// The client type of one worker.
-pub type Client = MicroSolverClient<InterceptedService<Channel, AttachToken>>;
+pub type Client = MicroSolverClient<InterceptedService<Transport, AttachToken>>;
 
 /// What a worker said at handshake.
 #[derive(Clone, Debug, Default)]
@@ -24,6 +48,18 @@ pub struct WorkerInfo {
     pub memory_bytes: u64,
     /// Its build.
     pub build_id: String,
+}
+
+/// A commit held back by the pool to ride on the worker's next SolveBatch (see
+/// [`Link::solve`]): the trial (step, iteration) of `ids` becomes their committed state.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct PendingCommit {
+    /// The load step committed.
+    pub step: u64,
+    /// The Newton iteration whose trial states are committed.
+    pub iteration: u32,
+    /// The worker's assemblies committed (never empty).
+    pub ids: Vec<GaussPointId>,
 }
 
 /// A worker the pool talks to.
@@ -52,8 +88,12 @@ pub fn is_worker_failure(s: &Status) -> bool {
     )
 }
 
-fn client(channel: Channel, token: Option<Token>, max_message: usize) -> Client {
-    MicroSolverClient::with_interceptor(channel, AttachToken(token))
+fn over_channel(channel: Channel) -> Transport {
+    Transport::new(channel.map_err(|e| TransportError(e.into())))
+}
+
+fn client(transport: Transport, token: Option<Token>, max_message: usize) -> Client {
+    MicroSolverClient::with_interceptor(transport, AttachToken(token))
         .max_decoding_message_size(max_message)
         .max_encoding_message_size(max_message)
 }
@@ -93,7 +133,7 @@ pub async fn connect_tcp(
         ep.connect().await.map_err(|e| Status::unavailable(format!("connect {addr}: {e}")))?;
     handshake(
         addr.to_string(),
-        client(channel, c.token.clone(), c.max_message_bytes),
+        client(over_channel(channel), c.token.clone(), c.max_message_bytes),
         c.connect_timeout,
     )
     .await
@@ -120,7 +160,27 @@ pub async fn connect_duplex(
         .connect_with_connector(connector)
         .await
         .map_err(|e| Status::unavailable(format!("connect {name}: {e}")))?;
-    handshake(name, client(channel, token, max_message), timeout).await
+    handshake(name, client(over_channel(channel), token, max_message), timeout).await
+}
+
+/// A worker inside this process with no transport: its service
+/// ([`cosdem_worker::service::direct`]) is called in the caller's task, so a call hands off
+/// to no connection task or runtime thread (a hand-off costs tens of microseconds of wake-up
+/// latency on a virtual machine, several per call over a transport). Then the handshake.
+pub async fn connect_direct<M: MicroModel>(
+    name: String,
+    model: M,
+    config: &WorkerConfig,
+    timeout: Duration,
+) -> Result<Link, Status> {
+    let service = cosdem_worker::service::direct(model, config)
+        .map_err(|e| Status::internal(format!("{name}: {e}")))?;
+    let service = ServiceExt::<http::Request<Body>>::map_response(service, |r| r.map(Body::new));
+    let service =
+        ServiceExt::<http::Request<Body>>::map_err(service, |e| -> TransportError { match e {} });
+    let transport = Transport::new(service);
+    let max = config.limits.max_message_bytes;
+    handshake(name, client(transport, config.token.clone(), max), timeout).await
 }
 
 fn with_timeout<T>(msg: T, timeout: Duration) -> Request<T> {
@@ -187,12 +247,14 @@ impl Link {
     }
 
     /// Solves a batch, collecting the streamed results; a stream that ends before every
-    /// Gauss point answered is a worker failure.
+    /// Gauss point answered is a worker failure. `commit` (the previous step's, held back by
+    /// the pool) is applied by the worker before the batch's relaxations start.
     pub async fn solve(
         &self,
         step: u64,
         iteration: u32,
         items: Vec<(GaussPointId, MacroDeformation)>,
+        commit: Option<PendingCommit>,
         timeout: Duration,
     ) -> Result<Vec<(GaussPointId, Result<MicroResponse, String>)>, Status> {
         let mut c = self.client.clone();
@@ -201,6 +263,12 @@ impl Link {
             step,
             iteration,
             items: items.into_iter().map(|(id, t)| to_proto::solve_item(id, t)).collect(),
+            commit: commit.map(|c| pb::CommitRequest {
+                step: c.step,
+                iteration: c.iteration,
+                ids: c.ids.into_iter().map(Into::into).collect(),
+                export_state: false,
+            }),
         };
         bounded(timeout, async move {
             let mut stream = c.solve_batch(with_timeout(req, timeout)).await?.into_inner();

@@ -6,7 +6,9 @@
 //! one worker per address) or [`Pool::in_process`], then [`Pool::create_assemblies`], then the
 //! FE solver drives it through [`Material`]: `evaluate` (one `SolveBatch` per worker per Newton
 //! iteration, all workers concurrently, each bounded by [`PoolConfig::solve_timeout`]),
-//! `commit`, `rollback`.
+//! `commit`, `rollback`. A commit that exports nothing is held back and carried on the
+//! worker's next `SolveBatch` ([`PoolConfig::defer_commits`]): one round trip per load step
+//! instead of two.
 //!
 //! # Runtime
 //! `Material` is synchronous; the pool owns a small multi-threaded tokio runtime and blocks
@@ -29,7 +31,10 @@
 //! costs up to `export_every - 1` replayed steps of the lost worker's assemblies. A worker
 //! that comes back, or a new address behind a DNS name, is admitted at a load step once it
 //! answers and is idle: the attempt (name resolution, connection, health) runs in the
-//! background and a step waits for it at most [`PoolConfig::admit_wait`].
+//! background and a step waits for it at most [`PoolConfig::admit_wait`]; attempts are made
+//! at every load step while a worker is lost, else at most every
+//! [`PoolConfig::admit_interval`]. A commit held back for the next `SolveBatch` is recorded in
+//! the history at once, so a worker lost before it was sent is restored with it.
 //!
 //! # Balance
 //! Assemblies are placed by expected cost (disc count, then measured solve time) per core;
@@ -49,7 +54,7 @@ use balance::{effective_costs, place, rebalance};
 use cosdem_common::micro::{AssemblyRequest, AssemblyState, MicroSnapshot};
 use cosdem_common::{GaussPointId, MacroDeformation, MicroResponse};
 use cosdem_worker::service::{Limits, MicroModel, Token, WorkerConfig, serve_duplex};
-use link::{Link, is_worker_failure};
+use link::{Link, PendingCommit, is_worker_failure};
 use replay::{History, Increment, ReplayPlan};
 use std::collections::BTreeMap;
 use std::net::SocketAddr;
@@ -118,6 +123,21 @@ pub struct PoolConfig {
     /// resolution, connection, health check; each bounded by `connect_timeout`). An attempt
     /// not finished by then goes on in the background and is taken up at a later step.
     pub admit_wait: Duration,
+    /// Least time between two admission attempts while every worker is alive (new addresses
+    /// behind a name are looked for this often); with a worker lost, every load step tries.
+    /// An attempt costs a name lookup and a hand-off to the runtime even when it finds
+    /// nothing, which short load steps would otherwise pay each time.
+    pub admit_interval: Duration,
+    /// Carry a commit that exports nothing on the worker's next SolveBatch instead of a Commit
+    /// call of its own (one round trip fewer per load step; protocol 2). The commit is taken
+    /// as done by the master at once (its increment is recorded for failover), and is sent
+    /// on its own before any other call that needs the committed states (rollback, export,
+    /// migration, snapshot). Default true; false sends every commit at once.
+    pub defer_commits: bool,
+    /// In-process workers over an in-memory HTTP/2 connection (`tokio::io::duplex`) instead
+    /// of their service called directly: the transport's framing and its connection tasks
+    /// included, as over TCP. Default false (measured: `cosdem bench floor`).
+    pub in_process_duplex: bool,
 }
 
 impl PoolConfig {
@@ -147,6 +167,9 @@ impl Default for PoolConfig {
             tls: None,
             export_every: 10,
             admit_wait: Duration::from_secs(1),
+            admit_interval: Duration::from_secs(1),
+            defer_commits: true,
+            in_process_duplex: false,
         }
     }
 }
@@ -168,6 +191,9 @@ pub struct PoolStats {
     pub replayed: u64,
     /// Commits that also exported the committed states.
     pub exports: u64,
+    /// Commits (one per worker and step) carried on the worker's next SolveBatch instead of
+    /// a Commit call ([`PoolConfig::defer_commits`]).
+    pub carried_commits: u64,
 }
 
 struct Worker {
@@ -191,6 +217,11 @@ pub struct Pool {
     committed_step: u64,
     stats: PoolStats,
     admission: Option<tokio::task::JoinHandle<Vec<(SocketAddr, Link)>>>,
+    /// When the last admission attempt started.
+    admitted_at: Option<std::time::Instant>,
+    /// Commits held back per worker, to ride on its next SolveBatch
+    /// ([`PoolConfig::defer_commits`]).
+    deferred: BTreeMap<usize, PendingCommit>,
     _stops: Vec<tokio::sync::oneshot::Sender<()>>,
 }
 
@@ -328,7 +359,8 @@ async fn replay_on(
     for batch in plan.batches {
         let ids: Vec<_> = batch.items.iter().map(|(id, _)| *id).collect();
         replayed += ids.len() as u64;
-        let results = link.solve(batch.step, batch.iteration, batch.items, solve_timeout).await?;
+        let results =
+            link.solve(batch.step, batch.iteration, batch.items, None, solve_timeout).await?;
         if let Some((id, e)) = results.into_iter().find_map(|(id, r)| r.err().map(|e| (id, e))) {
             return Ok(Err((id, e)));
         }
@@ -395,9 +427,12 @@ impl Pool {
         Ok(pool)
     }
 
-    /// `n` workers inside this process, each a full MicroSolver service reached over an
-    /// in-memory `tokio::io::duplex` transport (the same code path as the network, no port).
-    /// `factory(i)` builds worker `i`'s model. What `cosdem run` uses without `--workers`.
+    /// `n` workers inside this process, each a full MicroSolver service (request decoding,
+    /// token check, limits, response encoding: the code path of the network without the
+    /// network) called directly in the pool's task, or, with
+    /// [`PoolConfig::in_process_duplex`], reached over an in-memory `tokio::io::duplex`
+    /// HTTP/2 connection. `factory(i)` builds worker `i`'s model. What `cosdem run` uses
+    /// without `--workers`.
     pub fn in_process<M: MicroModel>(
         n: usize,
         config: PoolConfig,
@@ -429,6 +464,16 @@ impl Pool {
                 ..WorkerConfig::default()
             };
             let model = factory(i);
+            let c = &pool.config;
+            let name = format!("in-process worker {i}");
+            if !c.in_process_duplex {
+                let link = pool
+                    .handle
+                    .block_on(link::connect_direct(name.clone(), model, &wc, c.connect_timeout))
+                    .map_err(|s| refused(&name, &s))?;
+                pool.workers.push(Worker { link, addr: None, alive: true });
+                continue;
+            }
             pool.handle.spawn(async move {
                 if let Err(e) = serve_duplex(conn_rx, wc, model, async {
                     let _ = stop_rx.await;
@@ -438,8 +483,6 @@ impl Pool {
                     tracing::error!("in-process worker {i}: {e}");
                 }
             });
-            let c = &pool.config;
-            let name = format!("in-process worker {i}");
             let link = pool
                 .handle
                 .block_on(link::connect_duplex(
@@ -473,6 +516,8 @@ impl Pool {
             last: None,
             current_step: None,
             committed_step: 0,
+            deferred: BTreeMap::new(),
+            admitted_at: None,
             stats: PoolStats::default(),
             admission: None,
             _stops: Vec::new(),
@@ -539,11 +584,14 @@ impl Pool {
         self.owner.clear();
         self.history.clear();
         self.costs.clear();
+        self.deferred.clear();
         self.last = None;
     }
 
     /// Particle-level snapshot of one assembly (committed state).
     pub fn snapshot(&mut self, id: GaussPointId) -> Result<MicroSnapshot, PoolError> {
+        let h = self.handle.clone();
+        h.block_on(self.flush_deferred()).map_err(|e| PoolError::Unavailable(e.to_string()))?;
         let w = *self
             .owner
             .get(&id)
@@ -594,6 +642,8 @@ impl Pool {
             self.workers[w].alive = false;
             self.stats.workers_lost += 1;
         }
+        // Its held-back commit is in the history: the restore replays it.
+        self.deferred.remove(&w);
     }
 
     async fn create_async(
@@ -647,6 +697,7 @@ impl Pool {
     /// them as the failover copies. A worker that fails here is an error: the checkpoint is
     /// not written and the next step's failover handles the loss.
     async fn export_all(&mut self) -> Result<(), MaterialError> {
+        self.flush_deferred().await?;
         let t = self.config.call_timeout;
         let jobs = (0..self.workers.len())
             .filter(|w| self.workers[*w].alive)
@@ -822,10 +873,13 @@ impl Pool {
                 .into_iter()
                 .map(|(w, items)| {
                     let link = self.workers[w].link.clone();
-                    let job: Job<_> =
-                        Box::pin(
-                            async move { link.solve(trial.step, trial.iteration, items, t).await },
-                        );
+                    // A held-back commit is applied by the worker before this batch; if the
+                    // worker fails instead, the restore replays it from the history.
+                    let commit = self.deferred.remove(&w);
+                    self.stats.carried_commits += u64::from(commit.is_some());
+                    let job: Job<_> = Box::pin(async move {
+                        link.solve(trial.step, trial.iteration, items, commit, t).await
+                    });
                     (w, job)
                 })
                 .collect();
@@ -918,6 +972,7 @@ impl Pool {
                 trial.step
             )));
         }
+        self.flush_deferred().await?;
         let mut pending: Vec<GaussPointId> = targets.keys().copied().collect();
         // Ends: a pass that leaves work lost at least one worker (see `restore`).
         let mut rounds = 0usize;
@@ -933,6 +988,32 @@ impl Pool {
             let mut by_worker: BTreeMap<usize, Vec<GaussPointId>> = BTreeMap::new();
             for id in &pending {
                 by_worker.entry(self.owner[id]).or_default().push(*id);
+            }
+            if self.config.defer_commits {
+                // Those that export nothing now ride on their worker's next SolveBatch: taken
+                // as committed here (the increments recorded for failover, as after an
+                // acknowledged commit), sent with the next batch or before another call.
+                let held: Vec<usize> = by_worker
+                    .iter()
+                    .filter(|(_, ids)| !self.history.export_due(ids, every))
+                    .map(|(w, _)| *w)
+                    .collect();
+                for w in held {
+                    let ids = by_worker.remove(&w).unwrap_or_default();
+                    for id in &ids {
+                        self.history.record(
+                            *id,
+                            Increment { step, iteration: trial.iteration, target: targets[id] },
+                        );
+                    }
+                    // The only commit held for `w` (flushed above): ids of a later round
+                    // (re-solved after a loss) join it.
+                    self.deferred
+                        .entry(w)
+                        .or_insert(PendingCommit { step, iteration: trial.iteration, ids: vec![] })
+                        .ids
+                        .extend(ids);
+                }
             }
             let t = self.config.call_timeout;
             let jobs = by_worker
@@ -1007,7 +1088,42 @@ impl Pool {
         Ok(())
     }
 
+    /// Sends the held-back commits ([`PoolConfig::defer_commits`]) now, as Commit calls of
+    /// their own: before any call that reads or discards states. A worker lost here is
+    /// restored from the history, which holds the commit already.
+    async fn flush_deferred(&mut self) -> Result<(), MaterialError> {
+        if self.deferred.is_empty() {
+            return Ok(());
+        }
+        let t = self.config.call_timeout;
+        let jobs = std::mem::take(&mut self.deferred)
+            .into_iter()
+            .filter(|(w, _)| self.workers[*w].alive)
+            .map(|(w, c)| {
+                let link = self.workers[w].link.clone();
+                let job: Job<_> =
+                    Box::pin(
+                        async move { link.commit(&c.ids, c.step, c.iteration, false, t).await },
+                    );
+                (w, job)
+            })
+            .collect();
+        let mut lost = Vec::new();
+        for (w, r) in fan_out(jobs).await {
+            match r {
+                Ok(_) => {}
+                Err(s) if is_worker_failure(&s) => {
+                    self.mark_dead(w, &s);
+                    lost.extend(self.owned_by(w));
+                }
+                Err(s) => return Err(self.unavailable(w, "commit", &s)),
+            }
+        }
+        self.restore(&lost).await
+    }
+
     async fn rollback_async(&mut self) -> Result<(), MaterialError> {
+        self.flush_deferred().await?;
         self.last = None;
         let mut by_worker: BTreeMap<usize, Vec<GaussPointId>> = BTreeMap::new();
         for (id, w) in &self.owner {
@@ -1051,6 +1167,8 @@ impl Pool {
         if moves.is_empty() {
             return Ok(());
         }
+        // Migration exports committed states: the sources must hold them.
+        self.flush_deferred().await?;
         let mut by_dest: BTreeMap<usize, Vec<(GaussPointId, usize)>> = BTreeMap::new();
         for (id, from, to) in moves {
             by_dest.entry(to).or_default().push((id, from));
@@ -1147,6 +1265,13 @@ impl Pool {
         let task = match self.admission.take() {
             Some(t) => t,
             None => {
+                let all_alive = self.workers.iter().all(|w| w.alive);
+                let recent =
+                    self.admitted_at.is_some_and(|t| t.elapsed() < self.config.admit_interval);
+                if all_alive && recent {
+                    return;
+                }
+                self.admitted_at = Some(std::time::Instant::now());
                 let live: Vec<SocketAddr> =
                     self.workers.iter().filter(|w| w.alive).filter_map(|w| w.addr).collect();
                 let (sources, config) = (self.sources.clone(), self.config.clone());

@@ -2,7 +2,8 @@
 //!
 //! - [`serve`] listens on TCP until a shutdown future resolves (use [`shutdown_signal`] for
 //!   SIGTERM / Ctrl-C); [`serve_listener`] takes a bound listener (tests bind port 0);
-//!   [`serve_duplex`] serves in-memory `tokio::io::duplex` connections (in-process workers).
+//!   [`serve_duplex`] serves in-memory `tokio::io::duplex` connections; [`direct`] is the
+//!   service with no transport at all, called in the caller's task (in-process workers).
 //! - The shared secret is checked on every MicroSolver call by [`CheckToken`]; the standard
 //!   `grpc.health.v1.Health` service (tonic-health) answers readiness probes without one.
 //! - Status codes (mapped in one place, `error.rs`): unknown id NOT_FOUND, NaN or
@@ -44,6 +45,23 @@ pub const BUILD_ID: &str = concat!("cosdem-worker ", env!("CARGO_PKG_VERSION"));
 
 /// Interval of HTTP/2 keepalive pings (so a master notices a dead peer between calls).
 const KEEPALIVE: std::time::Duration = std::time::Duration::from_secs(10);
+
+/// The MicroSolver service with its token check, as a plain tower service of HTTP requests:
+/// what [`direct`] returns.
+pub type DirectService<M> = InterceptedService<MicroSolverServer<WorkerService<M>>, CheckToken>;
+
+/// An in-process worker with no transport: the generated server (request decoding, the token
+/// interceptor, the message-size limits, response encoding) called directly by a client in
+/// the caller's task, so a call costs no connection task and no thread hand-off but the
+/// relaxations' own (the rayon pool and back). No TLS, no HTTP/2 keepalive, no grpc-timeout
+/// enforcement on this side (the caller bounds its calls itself).
+pub fn direct<M: MicroModel>(model: M, config: &WorkerConfig) -> Result<DirectService<M>> {
+    let max = config.limits.max_message_bytes;
+    let service = MicroSolverServer::new(WorkerService::new(model, config.clone())?)
+        .max_decoding_message_size(max)
+        .max_encoding_message_size(max);
+    Ok(InterceptedService::new(service, CheckToken(config.token.clone())))
+}
 
 async fn router<M: MicroModel>(model: M, config: &WorkerConfig) -> Result<Router> {
     let (reporter, health) = tonic_health::server::health_reporter();

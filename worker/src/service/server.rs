@@ -149,6 +149,19 @@ impl<M: MicroModel> MicroSolver for WorkerService<M> {
         }
         let list: Vec<_> = items.iter().map(|(id, _)| *id).collect();
         let handles = self.registry.resolve(&list)?;
+        if let Some(c) = req.commit {
+            // The previous step's commit, carried here to save its round trip: applied in
+            // full (every assembly checked before any changes) before a relaxation of this
+            // batch starts, since they start from the committed states. A commit moves
+            // trial states, it does not compute: done on this thread.
+            if c.export_state {
+                return Err(invalid("commit", "a commit carried on a SolveBatch cannot export"));
+            }
+            let ids = ids(c.ids);
+            if !ids.is_empty() {
+                self.registry.commit(&ids, c.step, c.iteration, false)?;
+            }
+        }
         let (tx, rx) = tokio::sync::mpsc::unbounded_channel();
         for (h, (_, target)) in handles.into_iter().zip(items) {
             let registry = self.registry.clone();
