@@ -261,29 +261,61 @@ pub enum Driver {
     /// Cundall's local non-viscous damping: `F_i <- F_i (1 - alpha sign(F_i v_i))`.
     Cundall {
         /// Damping coefficient in [0, 1) (default 0.7).
+        #[serde(default = "defaults::alpha")]
         alpha: f64,
     },
     /// FIRE (Bitzek et al. 2006) with the usual parameters.
     Fire {
         /// Initial velocity-mixing factor (default 0.1).
+        #[serde(default = "defaults::alpha_start")]
         alpha_start: f64,
         /// Step growth factor after `n_min` downhill steps (default 1.1).
+        #[serde(default = "defaults::f_inc")]
         f_inc: f64,
         /// Step shrink factor on an uphill step (default 0.5).
+        #[serde(default = "defaults::f_dec")]
         f_dec: f64,
         /// Mixing decay (default 0.99).
+        #[serde(default = "defaults::f_alpha")]
         f_alpha: f64,
         /// Downhill steps before the step may grow (default 5).
+        #[serde(default = "defaults::n_min")]
         n_min: u32,
         /// Largest step as a multiple of the base step (default 1.8, since the base step is
         /// 0.5 of the critical step bound).
+        #[serde(default = "defaults::dt_max")]
         dt_max: f64,
     },
 }
 
+/// The defaults of the drivers' parameters (a job may give `{ kind = "fire" }` alone).
+mod defaults {
+    pub fn alpha() -> f64 {
+        0.7
+    }
+    pub fn alpha_start() -> f64 {
+        0.1
+    }
+    pub fn f_inc() -> f64 {
+        1.1
+    }
+    pub fn f_dec() -> f64 {
+        0.5
+    }
+    pub fn f_alpha() -> f64 {
+        0.99
+    }
+    pub fn n_min() -> u32 {
+        5
+    }
+    pub fn dt_max() -> f64 {
+        1.8
+    }
+}
+
 impl Default for Driver {
     fn default() -> Self {
-        Self::Cundall { alpha: 0.7 }
+        Self::Cundall { alpha: defaults::alpha() }
     }
 }
 
@@ -291,12 +323,12 @@ impl Driver {
     /// FIRE with its default parameters.
     pub fn fire() -> Self {
         Self::Fire {
-            alpha_start: 0.1,
-            f_inc: 1.1,
-            f_dec: 0.5,
-            f_alpha: 0.99,
-            n_min: 5,
-            dt_max: 1.8,
+            alpha_start: defaults::alpha_start(),
+            f_inc: defaults::f_inc(),
+            f_dec: defaults::f_dec(),
+            f_alpha: defaults::f_alpha(),
+            n_min: defaults::n_min(),
+            dt_max: defaults::dt_max(),
         }
     }
 }
@@ -528,5 +560,22 @@ impl AssemblySpec {
         match &self.packing {
             PackingSpec::Hexagonal { side, .. } | PackingSpec::Random { side, .. } => *side,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A driver named by its kind alone takes the default parameters; a given one is kept.
+    #[test]
+    fn a_driver_by_its_kind_alone_has_the_defaults() {
+        let fire: Driver = serde_json::from_str(r#"{"kind": "fire"}"#).unwrap();
+        assert_eq!(fire, Driver::fire());
+        let cundall: Driver = serde_json::from_str(r#"{"kind": "cundall"}"#).unwrap();
+        assert_eq!(cundall, Driver::default());
+        let tuned: Driver = serde_json::from_str(r#"{"kind": "fire", "n_min": 3}"#).unwrap();
+        assert!(matches!(tuned, Driver::Fire { n_min: 3, f_inc, .. } if f_inc == 1.1));
+        assert!(serde_json::from_str::<Driver>(r#"{"kind": "fire", "nmin": 3}"#).is_err());
     }
 }

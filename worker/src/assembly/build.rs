@@ -5,7 +5,9 @@ use crate::contact::Law;
 use crate::error::{Error, Result};
 use crate::integrate::{self, Dynamics, Work, timestep::checked_step};
 use crate::packing::{Packing, hexagonal, random};
-use crate::spec::{AssemblySpec, BoundarySpec, PackingSpec, RollingModel, TangentialModel};
+use crate::spec::{
+    AssemblySpec, BoundarySpec, PackingSpec, RelaxationSpec, RollingModel, TangentialModel,
+};
 use cosdem_common::MacroDeformation;
 
 pub(super) fn new(spec: &AssemblySpec) -> Result<Assembly> {
@@ -19,34 +21,85 @@ pub(super) fn new(spec: &AssemblySpec) -> Result<Assembly> {
             };
             from_packing(spec, law, p)
         }
-        PackingSpec::Random { .. } => random_assembly(spec, law),
+        PackingSpec::Random { .. } => {
+            // The specimen is the material: generated with fixed relaxation settings, so that
+            // it depends on the packing, the contact law and the boundary only, never on the
+            // speed knobs (time-step safety, tolerance, driver, mass scaling, ...) its loading
+            // is relaxed with. Then it takes the job's relaxation settings.
+            let generation = generation_spec(spec);
+            let a = random_assembly(&generation, law)?;
+            respec(a, spec)
+        }
     }
+}
+
+/// The spec a random specimen is generated with: the job's, with the relaxation settings
+/// replaced by the defaults (the Verlet skin kept: it changes no result, only the pair-list
+/// rebuild rate), the paper tangent and cold starts. A job with the default relaxation
+/// settings gets exactly the specimen it got before this rule.
+fn generation_spec(spec: &AssemblySpec) -> AssemblySpec {
+    let mut g = spec.clone();
+    g.relaxation = RelaxationSpec { skin: spec.relaxation.skin, ..RelaxationSpec::default() };
+    g.tangent = crate::spec::TangentKind::Paper;
+    g.warm_start = false;
+    g
+}
+
+/// `a` driven by `spec` from now on: masses (mass scaling) and the time step (safety)
+/// recomputed from it; geometry, committed state and contact histories kept.
+fn respec(mut a: Assembly, spec: &AssemblySpec) -> Result<Assembly> {
+    if a.spec == *spec {
+        return Ok(a);
+    }
+    let (inv_m, inv_i, dt) = inertia(spec, &a.law, &a.refc.r, a.refc.area)?;
+    a.refc.inv_m = inv_m;
+    a.refc.inv_i = inv_i;
+    a.dt = dt;
+    a.spec = spec.clone();
+    a.trial = None;
+    Ok(a)
+}
+
+/// Inverse masses and moments of inertia of discs of radii `r` (mass scaling applied) and
+/// the relaxation's time step (safety times the critical step of the stiffest oscillator);
+/// an unusable step is an error naming the parameter.
+fn inertia(
+    spec: &AssemblySpec,
+    law: &Law,
+    r: &[f64],
+    area: f64,
+) -> Result<(Vec<f64>, Vec<f64>, f64)> {
+    let rho = spec.density * spec.relaxation.density_scale;
+    let mut inv_m = Vec::with_capacity(r.len());
+    let mut inv_i = Vec::with_capacity(r.len());
+    for &r in r {
+        let m = rho * std::f64::consts::PI * r * r;
+        inv_m.push(1.0 / m);
+        inv_i.push(2.0 / (m * r * r));
+    }
+    let r_min = r.iter().fold(f64::MAX, |a, &b| a.min(b));
+    let (kf, kc) = match spec.boundary {
+        BoundarySpec::Penalty { eps_f, eps_c } => (eps_f / area, eps_c / area),
+        BoundarySpec::Periodic => (0.0, 0.0),
+    };
+    let m_min = rho * std::f64::consts::PI * r_min * r_min;
+    let dt = spec.relaxation.safety
+        * checked_step(law, m_min, 0.5 * m_min * r_min * r_min, r_min, kf, kc)?;
+    Ok((inv_m, inv_i, dt))
 }
 
 /// An assembly at rest in the reference state of `p` (no histories, identity target).
 /// Fails, naming the parameter, when the explicit time step is unusable.
 pub(super) fn from_packing(spec: &AssemblySpec, law: Law, p: Packing) -> Result<Assembly> {
     let n = p.r.len();
-    let rho = spec.density * spec.relaxation.density_scale;
-    let mut inv_m = Vec::with_capacity(n);
-    let mut inv_i = Vec::with_capacity(n);
-    for &r in &p.r {
-        let m = rho * std::f64::consts::PI * r * r;
-        inv_m.push(1.0 / m);
-        inv_i.push(2.0 / (m * r * r));
-    }
     let r_min = p.r.iter().fold(f64::MAX, |a, &b| a.min(b));
     let r_max = p.r.iter().fold(0.0f64, |a, &b| a.max(b));
     let area = p.area();
-    let (boundary, kf, kc) = match spec.boundary {
-        BoundarySpec::Penalty { eps_f, eps_c } => {
-            (boundary_layer(&p.x, &p.y, p.lx, p.ly, 2.0 * r_max), eps_f / area, eps_c / area)
-        }
-        BoundarySpec::Periodic => (Vec::new(), 0.0, 0.0),
+    let boundary = match spec.boundary {
+        BoundarySpec::Penalty { .. } => boundary_layer(&p.x, &p.y, p.lx, p.ly, 2.0 * r_max),
+        BoundarySpec::Periodic => Vec::new(),
     };
-    let m_min = rho * std::f64::consts::PI * r_min * r_min;
-    let dt = spec.relaxation.safety
-        * checked_step(&law, m_min, 0.5 * m_min * r_min * r_min, r_min, kf, kc)?;
+    let (inv_m, inv_i, dt) = inertia(spec, &law, &p.r, area)?;
     let refc = Reference {
         r: p.r.clone(),
         inv_m,

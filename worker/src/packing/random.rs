@@ -13,7 +13,10 @@
 //!    the boundary springs' rest points are placed so the cut packing is in equilibrium,
 //!    then an isotropic re-compression restores the confining stress lost with the cut
 //!    contacts and becomes the reference. The final relaxation at the reference uses the full
-//!    contact law and the spec's tolerance. 827 discs (0.0784 m^2): about 0.5 s.
+//!    contact law. Every relaxation of the generation uses the default relaxation settings,
+//!    whatever the job's (the specimen is the material: a speed knob must not change it);
+//!    the assembly then relaxes its loading with the job's. 827 discs (0.0784 m^2): about
+//!    0.5 s.
 //!
 //! ChaCha8 with the given seed: same seed, same bits, on every host.
 
