@@ -70,45 +70,30 @@ fn accuracy_target_holds_on_a_scene_the_table_was_not_measured_on() {
 }
 
 /// The same scene with random polydisperse assemblies (radii 4-6 mm, equilibrated at
-/// 150 kPa): a micro-structure the hexagonal table never saw. Measured with the hexagonal
-/// table's picks (before the fallback): F_u 12.9 %, E 8.8 % off, with the default settings
-/// alone 13-15 % off. So the target falls back to the tight reference settings: the run IS
-/// the reference (bit-identical metrics) and is not cheaper; this test checks that fallback.
+/// 150 kPa, a penalty boundary): planned from the random table (`docs/tradeoff-biaxial.csv`:
+/// periodic 2-3 mm assemblies, smooth platens, 100 kPa), which this scene differs from in
+/// radii, boundary, platens, confinement and mesh. Its default is 2.8 % from its reference
+/// (the half load step), so only a 10 % target moves knobs; the promise is checked at 10 %.
+/// (Before the specimen was fixed across the knobs, this scene's default settings alone
+/// were 13-15 % from the tight reference: specimen scatter, not accuracy.)
 #[test]
-fn accuracy_target_falls_back_to_the_reference_on_random_assemblies() {
-    let scene = SCENE.replace(
-        "packing = { kind = \"hexagonal\", radius = 0.005, side = 0.08 }",
-        "packing = { kind = \"random\", r_min = 0.004, r_max = 0.006, side = 0.08, seed = 3, \
-         confining_stress = 1.5e5 }",
-    );
-    assert_ne!(scene, SCENE);
-    let (fast, tight, report) = runs(&scene, "random");
-    assert_eq!(report["fallback_to_reference"], serde_json::Value::Bool(true));
-    assert_eq!(fast.status, "finished");
-    assert_eq!(fast.metrics, tight.metrics, "the fallback run is the reference run");
-    assert_eq!(fast.dem_steps, tight.dem_steps);
+fn accuracy_target_holds_on_random_assemblies() {
+    let scene = SCENE
+        .replace(
+            "packing = { kind = \"hexagonal\", radius = 0.005, side = 0.08 }",
+            "packing = { kind = \"random\", r_min = 0.004, r_max = 0.006, side = 0.08, seed = 3, \
+             confining_stress = 1.5e5 }",
+        )
+        .replace("accuracy = 0.05", "accuracy = 0.1");
+    assert!(scene.contains("kind = \"random\"") && scene.contains("accuracy = 0.1"));
+    check(&scene, "random");
 }
 
-type Summary = cosdem_master::output::run_dir::Summary;
-
-/// Runs `scene` with its `accuracy` and with the tight reference settings; returns both
-/// summaries and the accuracy report.
-fn runs(scene: &str, name: &str) -> (Summary, Summary, serde_json::Value) {
-    let job = Job::from_toml(scene, "accuracy-scene").unwrap();
-    let dir =
-        std::env::temp_dir().join(format!("cosdem-accuracy-test-{name}-{}", std::process::id()));
-    let workers = WorkerChoice::default();
-    let (fast, _) = run_job(&job, &dir.join("accuracy"), &workers).unwrap();
-    let mut plain = job.clone();
-    plain.accuracy = None;
-    let (tight, _) = run_job(&reference(&plain).job, &dir.join("reference"), &workers).unwrap();
-    let report = std::fs::read_to_string(dir.join("accuracy").join("accuracy.json")).unwrap();
-    std::fs::remove_dir_all(&dir).ok();
-    (fast, tight, serde_json::from_str(&report).unwrap())
-}
-
+/// Runs `scene` with its `accuracy` target and with the tight reference settings, and checks
+/// the promise (F_u, E and F_res, if any, within the target) and that it was cheaper.
 fn check(scene: &str, name: &str) {
     let job = Job::from_toml(scene, "accuracy-scene").unwrap();
+    let target = job.accuracy.unwrap();
     let dir =
         std::env::temp_dir().join(format!("cosdem-accuracy-test-{name}-{}", std::process::id()));
     let workers = WorkerChoice::default();
@@ -146,14 +131,14 @@ fn check(scene: &str, name: &str) {
     );
     assert_eq!(fast.status, "finished");
     assert_eq!(tight.status, "finished");
-    assert!(!picked.is_empty(), "a 5 % target on this table moves some knob");
+    assert!(!picked.is_empty(), "this target on its table moves some knob");
     let peak = e.peak.unwrap();
     let stiffness = e.stiffness.unwrap();
-    assert!(peak <= 0.05, "F_u off by {:.2} %", 100.0 * peak);
-    assert!(stiffness <= 0.05, "E off by {:.2} %", 100.0 * stiffness);
+    assert!(peak <= target, "F_u off by {:.2} %", 100.0 * peak);
+    assert!(stiffness <= target, "E off by {:.2} %", 100.0 * stiffness);
     if tight.metrics.residual_load.is_some() {
         let r = e.residual.expect("the accuracy run passed the peak too");
-        assert!(r <= 0.05, "F_res off by {:.2} %", 100.0 * r);
+        assert!(r <= target, "F_res off by {:.2} %", 100.0 * r);
     }
     assert!(
         fast.dem_steps < tight.dem_steps,
