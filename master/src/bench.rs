@@ -53,7 +53,9 @@
 //! The step time of a job of `points` Gauss points (default 64): one iteration = one
 //! evaluate of all points + commit, averaged over `iterations`, with 1 worker x 1 thread and
 //! 2 workers x 1 thread, in-process and over TCP (worker processes with `--threads 1`).
-//! Speedup = time(1 worker) / time(2 workers), per repetition.
+//! Speedup = time(1 worker) / time(2 workers), per repetition. The same solves on 1 and 2
+//! plain threads without any coupling ([`run_direct_threads`]) give the machine's own
+//! ceiling: two virtual cores need not run two relaxations at twice the speed of one.
 //!
 //! # 3. FE versus DEM ([`fe_versus_dem`])
 //! The FE cost of one Newton iteration (material evaluation with the elastic Cosserat law,
@@ -201,6 +203,40 @@ pub fn run_direct(
     }
     run.seconds = t0.elapsed().as_secs_f64();
     Ok((run, discs))
+}
+
+/// The workload with direct [`Assembly::solve`] calls spread over `threads` threads (one
+/// assembly per task, as a worker's relaxation pool does): what the machine itself gives
+/// when two relaxations run at once, the ceiling of [`scaling`].
+pub fn run_direct_threads(
+    spec: &AssemblySpec,
+    points: usize,
+    iterations: u64,
+    threads: usize,
+) -> BenchResult<Run> {
+    use rayon::prelude::*;
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build()?;
+    let mut assemblies = (0..points).map(|_| Assembly::new(spec)).collect::<Result<Vec<_>, _>>()?;
+    let mut run = Run::default();
+    let t0 = Instant::now();
+    for k in 1..=iterations {
+        let t = target(k);
+        let responses = pool.install(|| {
+            assemblies
+                .par_iter_mut()
+                .map(|a| {
+                    let r = a.solve(&t)?;
+                    a.commit();
+                    Ok(r)
+                })
+                .collect::<Result<Vec<_>, cosdem_worker::Error>>()
+        })?;
+        for r in &responses {
+            run.record(r);
+        }
+    }
+    run.seconds = t0.elapsed().as_secs_f64();
+    Ok(run)
 }
 
 /// The workload through `pool` (assemblies created first, untimed; released afterwards).
@@ -479,7 +515,8 @@ pub fn overhead(w: &Workload, out: &mut dyn Write) -> BenchResult<()> {
 pub fn scaling(w: &Workload, out: &mut dyn Write) -> BenchResult<()> {
     let spec = hexagonal_spec(w.discs);
     let discs = Assembly::new(&spec)?.disc_count();
-    let mut transports: Vec<(&str, Option<[WorkerProcesses; 2]>)> = vec![("in-process", None)];
+    let mut transports: Vec<(&str, Option<[WorkerProcesses; 2]>)> =
+        vec![("direct", None), ("in-process", None)];
     if let Some(bin) = &w.worker_bin {
         transports.push((
             "tcp",
@@ -494,6 +531,13 @@ pub fn scaling(w: &Workload, out: &mut dyn Write) -> BenchResult<()> {
             let mut busiest = [0; 2];
             let mut runs = Vec::new();
             for (k, n) in [1usize, 2].into_iter().enumerate() {
+                if *name == "direct" {
+                    let r = run_direct_threads(&spec, w.points, w.iterations, n)?;
+                    step[k] = r.seconds / w.iterations as f64;
+                    busiest[k] = w.points.div_ceil(n);
+                    runs.push(r);
+                    continue;
+                }
                 let mut pool = match procs {
                     None => in_process_pool(n, w)?,
                     Some(p) => tcp_pool(&p[k], w)?,
@@ -538,7 +582,9 @@ pub fn scaling(w: &Workload, out: &mut dyn Write) -> BenchResult<()> {
         out,
         "Scaling: step time (one evaluate of {} Gauss points + commit) of {discs}-disc \
          assemblies, workers of 1 thread each, states exported every {} commits, {} iterations x \
-         {} repetitions, median [min .. max]; {} cores available:",
+         {} repetitions, median [min .. max]; {} cores available; `direct` = the same solves \
+         on 1 and 2 plain threads, no coupling (what this machine gives two relaxations at \
+         once: the ceiling of the others):",
         w.points,
         w.export_every,
         w.iterations,
