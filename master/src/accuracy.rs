@@ -217,7 +217,7 @@ impl Trade {
             PackingSpec::Hexagonal { .. } => Self::measured(),
             PackingSpec::Random { .. } => {
                 let mut t = Self::from_csv(RANDOM_TABLE, RANDOM_TABLE_NAME)?;
-                t.packing = "random".into();
+                t.packing = packing_kind(packing).into();
                 Ok(t)
             }
         }
@@ -891,6 +891,16 @@ mod tests {
         Job::from_toml(&text, "quick").unwrap()
     }
 
+    /// The quick job with random 4-6 mm assemblies and `accuracy`.
+    fn random_quick(accuracy: f64) -> Job {
+        let text = format!("accuracy = {accuracy}\n{}", include_str!("../../examples/quick.toml"))
+            .replace(
+                r#"packing = { kind = "hexagonal", radius = 0.005, side = 0.1 }"#,
+                r#"packing = { kind = "random", r_min = 0.004, r_max = 0.006, side = 0.1, seed = 3, confining_stress = 1e5 }"#,
+            );
+        Job::from_toml(&text, "random").unwrap()
+    }
+
     fn assembly(job: &Job) -> &AssemblySpec {
         match &job.material {
             MaterialSection::Dem { assembly } => assembly,
@@ -1015,12 +1025,7 @@ mod tests {
     /// is the tight reference, with a warning.
     #[test]
     fn another_packing_falls_back_to_the_reference() {
-        let text = format!("accuracy = 0.05\n{}", include_str!("../../examples/quick.toml"))
-            .replace(
-                r#"packing = { kind = "hexagonal", radius = 0.005, side = 0.1 }"#,
-                r#"packing = { kind = "random", r_min = 0.004, r_max = 0.006, side = 0.1, seed = 3, confining_stress = 1e5 }"#,
-            );
-        let job = Job::from_toml(&text, "random").unwrap();
+        let job = random_quick(0.05);
         let plan = plan(&job, &Trade::measured().unwrap(), &[]).unwrap().unwrap();
         assert!(plan.report.fallback_to_reference);
         assert!(plan.report.warnings[0].contains("does not carry over to random"));
@@ -1036,20 +1041,12 @@ mod tests {
     /// (4.6-13 % there).
     #[test]
     fn a_random_packing_is_planned_from_the_random_table() {
-        let job = |a: f64| {
-            let text = format!("accuracy = {a}\n{}", include_str!("../../examples/quick.toml"))
-                .replace(
-                    r#"packing = { kind = "hexagonal", radius = 0.005, side = 0.1 }"#,
-                    r#"packing = { kind = "random", r_min = 0.004, r_max = 0.006, side = 0.1, seed = 3, confining_stress = 1e5 }"#,
-                );
-            Job::from_toml(&text, "random").unwrap()
-        };
-        let tight = tune(&job(0.05)).unwrap().unwrap();
+        let tight = tune(&random_quick(0.05)).unwrap().unwrap();
         assert!(!tight.report.fallback_to_reference);
         assert_eq!(tight.report.table, RANDOM_TABLE_NAME);
         assert!(tight.report.knobs.iter().all(|k| k.row.is_none()), "{:?}", tight.report.knobs);
         assert!(tight.report.warnings.iter().any(|w| w.contains("default settings alone")));
-        let loose = tune(&job(0.1)).unwrap().unwrap();
+        let loose = tune(&random_quick(0.1)).unwrap().unwrap();
         let rows: Vec<_> = loose.report.knobs.iter().filter_map(|c| c.row.clone()).collect();
         eprintln!("picked {rows:?}, predicted {:?}", loose.report.predicted);
         assert!(!rows.is_empty());

@@ -452,8 +452,6 @@ impl Pool {
             (cores / n).max(1)
         };
         for i in 0..n {
-            let (conn_tx, conn_rx) = tokio::sync::mpsc::unbounded_channel();
-            let (stop_tx, stop_rx) = tokio::sync::oneshot::channel::<()>();
             let wc = WorkerConfig {
                 token: pool.config.token.clone(),
                 threads,
@@ -464,39 +462,48 @@ impl Pool {
                 ..WorkerConfig::default()
             };
             let model = factory(i);
-            let c = &pool.config;
             let name = format!("in-process worker {i}");
-            if !c.in_process_duplex {
-                let link = pool
-                    .handle
-                    .block_on(link::connect_direct(name.clone(), model, &wc, c.connect_timeout))
-                    .map_err(|s| refused(&name, &s))?;
-                pool.workers.push(Worker { link, addr: None, alive: true });
-                continue;
+            let link = if pool.config.in_process_duplex {
+                pool.spawn_duplex_worker(i, name.clone(), model, wc)
+            } else {
+                let timeout = pool.config.connect_timeout;
+                pool.handle.block_on(link::connect_direct(name.clone(), model, &wc, timeout))
             }
-            pool.handle.spawn(async move {
-                if let Err(e) = serve_duplex(conn_rx, wc, model, async {
-                    let _ = stop_rx.await;
-                })
-                .await
-                {
-                    tracing::error!("in-process worker {i}: {e}");
-                }
-            });
-            let link = pool
-                .handle
-                .block_on(link::connect_duplex(
-                    name.clone(),
-                    conn_tx,
-                    c.token.clone(),
-                    c.connect_timeout,
-                    c.max_message_bytes,
-                ))
-                .map_err(|s| refused(&name, &s))?;
+            .map_err(|s| refused(&name, &s))?;
             pool.workers.push(Worker { link, addr: None, alive: true });
-            pool._stops.push(stop_tx);
         }
         Ok(pool)
+    }
+
+    /// Serves `model` on the pool's runtime over in-memory HTTP/2 connections
+    /// ([`PoolConfig::in_process_duplex`]) and connects to it; the server stops with the pool.
+    fn spawn_duplex_worker<M: MicroModel>(
+        &mut self,
+        i: usize,
+        name: String,
+        model: M,
+        wc: WorkerConfig,
+    ) -> Result<Link, Status> {
+        let (conn_tx, conn_rx) = tokio::sync::mpsc::unbounded_channel();
+        let (stop_tx, stop_rx) = tokio::sync::oneshot::channel::<()>();
+        self.handle.spawn(async move {
+            if let Err(e) = serve_duplex(conn_rx, wc, model, async {
+                let _ = stop_rx.await;
+            })
+            .await
+            {
+                tracing::error!("in-process worker {i}: {e}");
+            }
+        });
+        self._stops.push(stop_tx);
+        let c = &self.config;
+        self.handle.block_on(link::connect_duplex(
+            name,
+            conn_tx,
+            c.token.clone(),
+            c.connect_timeout,
+            c.max_message_bytes,
+        ))
     }
 
     fn empty(
@@ -989,31 +996,27 @@ impl Pool {
             for id in &pending {
                 by_worker.entry(self.owner[id]).or_default().push(*id);
             }
-            if self.config.defer_commits {
-                // Those that export nothing now ride on their worker's next SolveBatch: taken
-                // as committed here (the increments recorded for failover, as after an
-                // acknowledged commit), sent with the next batch or before another call.
-                let held: Vec<usize> = by_worker
-                    .iter()
-                    .filter(|(_, ids)| !self.history.export_due(ids, every))
-                    .map(|(w, _)| *w)
-                    .collect();
-                for w in held {
-                    let ids = by_worker.remove(&w).unwrap_or_default();
-                    for id in &ids {
-                        self.history.record(
-                            *id,
-                            Increment { step, iteration: trial.iteration, target: targets[id] },
-                        );
-                    }
-                    // The only commit held for `w` (flushed above): ids of a later round
-                    // (re-solved after a loss) join it.
-                    self.deferred
-                        .entry(w)
-                        .or_insert(PendingCommit { step, iteration: trial.iteration, ids: vec![] })
-                        .ids
-                        .extend(ids);
+            // Those that export nothing ride on their worker's next SolveBatch: taken as
+            // committed here (the increments recorded for failover, as after an acknowledged
+            // commit), sent with the next batch or before another call.
+            let defer = self.config.defer_commits;
+            let (held, by_worker): (BTreeMap<_, _>, BTreeMap<_, _>) = by_worker
+                .into_iter()
+                .partition(|(_, ids)| defer && !self.history.export_due(ids, every));
+            for (w, ids) in held {
+                for id in &ids {
+                    self.history.record(
+                        *id,
+                        Increment { step, iteration: trial.iteration, target: targets[id] },
+                    );
                 }
+                // The only commit held for `w` (flushed above): ids of a later round
+                // (re-solved after a loss) join it.
+                self.deferred
+                    .entry(w)
+                    .or_insert(PendingCommit { step, iteration: trial.iteration, ids: vec![] })
+                    .ids
+                    .extend(ids);
             }
             let t = self.config.call_timeout;
             let jobs = by_worker

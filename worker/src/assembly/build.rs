@@ -56,7 +56,6 @@ fn respec(mut a: Assembly, spec: &AssemblySpec) -> Result<Assembly> {
     a.refc.inv_i = inv_i;
     a.dt = dt;
     a.spec = spec.clone();
-    a.trial = None;
     Ok(a)
 }
 
