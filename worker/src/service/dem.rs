@@ -38,6 +38,12 @@ impl MicroModel for Dem {
         Assembly::new(&spec).map_err(|e| ModelError::InvalidSpec(e.to_string()))
     }
 
+    /// [`Assembly::new`] depends on the spec alone (a random packing's seed is in the spec),
+    /// so every Gauss point of one spec holds the same specimen.
+    fn replicate(&self, assembly: &Assembly, _id: GaussPointId) -> Option<Assembly> {
+        Some(assembly.clone())
+    }
+
     fn solve(
         &self,
         assembly: &mut Assembly,

@@ -79,6 +79,14 @@ pub trait MicroModel: Send + Sync + 'static {
     fn snapshot(&self, assembly: &Self::Assembly) -> MicroSnapshot;
     /// Number of discs (limits, load balancing).
     fn disc_count(&self, assembly: &Self::Assembly) -> u64;
+    /// A copy of a freshly created `assembly` for Gauss point `id`, if `create` does not
+    /// depend on the Gauss point (one spec builds one specimen). Then the points of one
+    /// `CreateAssemblies` call are built once and copied: the copies are the very bits `create`
+    /// would build, at none of its cost (a random packing's compression and equilibration).
+    /// `None` (the default): every point is built by `create`.
+    fn replicate(&self, _assembly: &Self::Assembly, _id: GaussPointId) -> Option<Self::Assembly> {
+        None
+    }
     /// Relative cost of one relaxation; the disc count unless the model knows better.
     fn cost_hint(&self, assembly: &Self::Assembly) -> f64 {
         self.disc_count(assembly) as f64

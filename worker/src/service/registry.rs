@@ -111,12 +111,7 @@ impl<M: MicroModel> Registry<M> {
             let hinted: Vec<_> = ids.iter().map(|id| (*id, spec.disc_count_hint)).collect();
             self.check_limits(&entries, &hinted)?;
         }
-        let built = {
-            use rayon::prelude::*;
-            ids.par_iter()
-                .map(|id| self.model.create(*id, spec).map(|a| (*id, a)))
-                .collect::<std::result::Result<Vec<_>, _>>()?
-        };
+        let built = self.build(ids, spec)?;
         let mut entries = lock(&self.entries);
         if let Some(id) = ids.iter().find(|id| entries.contains_key(id)) {
             return Err(ServiceError::AlreadyExists(*id));
@@ -135,6 +130,29 @@ impl<M: MicroModel> Registry<M> {
             infos.push(info);
         }
         Ok(infos)
+    }
+
+    /// The assemblies of `ids` from one spec: the first built and the rest copied where the
+    /// model says a copy is what it would build ([`MicroModel::replicate`]), else all built in
+    /// parallel.
+    fn build(
+        &self,
+        ids: &[GaussPointId],
+        spec: &AssemblyRequest,
+    ) -> Result<Vec<(GaussPointId, M::Assembly)>> {
+        use rayon::prelude::*;
+        let Some((first, rest)) = ids.split_first() else { return Ok(Vec::new()) };
+        let a = self.model.create(*first, spec)?;
+        let copies: Option<Vec<_>> =
+            rest.iter().map(|id| self.model.replicate(&a, *id).map(|c| (*id, c))).collect();
+        let rest = match copies {
+            Some(c) => c,
+            None => rest
+                .par_iter()
+                .map(|id| self.model.create(*id, spec).map(|a| (*id, a)))
+                .collect::<std::result::Result<Vec<_>, _>>()?,
+        };
+        Ok(std::iter::once((*first, a)).chain(rest).collect())
     }
 
     /// Creates or replaces assemblies from exported committed states; all or nothing.
@@ -323,5 +341,59 @@ impl<A> SlotHandle<A> {
     /// The Gauss point.
     pub fn id(&self) -> GaussPointId {
         self.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::service::Dem;
+    use crate::{Assembly, AssemblySpec, PackingSpec};
+
+    fn random_spec() -> AssemblySpec {
+        AssemblySpec {
+            packing: PackingSpec::Random {
+                r_min: 0.002,
+                r_max: 0.003,
+                radii: vec![],
+                side: 0.04,
+                seed: 11,
+                confining_stress: 1e5,
+            },
+            ..Default::default()
+        }
+    }
+
+    /// One spec for several Gauss points builds one random specimen and copies it: every
+    /// point's committed state is, byte for byte, the specimen `Assembly::new` builds alone,
+    /// and each copy relaxes as a freshly built one does (the copies share nothing). A copy
+    /// that differed (a stale trial, shared state, another packing) would fail the byte
+    /// comparison.
+    #[test]
+    fn one_spec_builds_one_specimen_for_all_points() {
+        let spec = random_spec();
+        let req = AssemblyRequest {
+            spec_json: serde_json::to_vec(&spec).unwrap(),
+            boundary: Default::default(),
+            disc_count_hint: 100,
+        };
+        let reg = Registry::new(Dem, Limits::default());
+        let ids: Vec<_> = (0..3).map(|p| GaussPointId::new(4, p)).collect();
+        reg.create(&ids, &req).unwrap();
+        let alone = Assembly::new(&spec).unwrap();
+        let states = reg.export(&ids).unwrap();
+        assert_eq!(states.len(), 3);
+        for s in &states {
+            assert_eq!(s.state, alone.to_bytes(), "{}", s.id);
+        }
+        let target = MacroDeformation { f: [[1.0, 2e-4], [0.0, 0.999]], w: 1e-4, kappa: [0.0; 2] };
+        let mut fresh = Assembly::new(&spec).unwrap();
+        let want = fresh.solve(&target).unwrap();
+        let handles = reg.resolve(&ids[1..2]).unwrap();
+        let got = reg.solve(&handles[0], 1, 0, target).unwrap();
+        assert_eq!(got.stress, want.stress);
+        assert_eq!(got.tangent, want.tangent);
+        // The other copies are untouched by that relaxation.
+        assert_eq!(reg.export(&ids[2..]).unwrap()[0].state, alone.to_bytes());
     }
 }
