@@ -263,3 +263,53 @@ fn tolerated_residual_accepts_steps_that_ran_out_of_iterations() {
     }
     assert!((solver.load_factor() - 1.0).abs() < 1e-12);
 }
+
+/// A step's `dem_steps` is the cost of every relaxation of the step: each evaluation the
+/// solver asks for (the predictor's, every Newton iteration, every line-search trial), not
+/// only the converged one. The material here reports 7 DEM steps per Gauss point per
+/// evaluation and counts its evaluations; its tangent is scaled by 0.4 so the step takes
+/// line-search halvings and several iterations (a count of the converged evaluation alone
+/// would be 7 x points per step, far below the sum).
+#[test]
+fn dem_steps_count_every_evaluation() {
+    struct Counting(ElasticCosserat, u64);
+    impl cosdem_master::material::Material for Counting {
+        fn evaluate(
+            &mut self,
+            trial: cosdem_master::material::TrialId,
+            inputs: &[cosdem_master::material::MaterialInput],
+        ) -> Result<Vec<cosdem_common::MicroResponse>, cosdem_master::material::MaterialError>
+        {
+            let mut r = self.0.evaluate(trial, inputs)?;
+            for x in &mut r {
+                x.tangent = x.tangent.map(|row| row.map(|v| 0.4 * v));
+                x.diagnostics.steps = 7;
+            }
+            self.1 += 7 * r.len() as u64;
+            Ok(r)
+        }
+        fn commit(&mut self, _: u64) -> Result<(), cosdem_master::material::MaterialError> {
+            Ok(())
+        }
+        fn rollback(&mut self) -> Result<(), cosdem_master::material::MaterialError> {
+            Ok(())
+        }
+    }
+    let mut model = panel(0.0);
+    model.loading.dirichlet.retain(|d| d.set == "bottom");
+    model.loading.edge_loads.push(cosdem_master::solve::EdgeLoad {
+        set: "top".into(),
+        kind: cosdem_master::solve::EdgeLoadKind::Pressure(1e5),
+        ramp: cosdem_master::solve::Ramp::Linear,
+    });
+    let settings = SolverSettings { steps: 2, max_iterations: 40, ..Default::default() };
+    let mut solver = Solver::new(model, settings).unwrap();
+    let mut log: Vec<StepReport> = Vec::new();
+    let mut material = Counting(elastic(), 0);
+    solver.run(&mut material, &mut log).unwrap();
+    let points = solver.solution().gauss_points.len() as u64;
+    let reported: u64 = log.iter().map(|s| s.dem_steps).sum();
+    assert_eq!(reported, material.1);
+    assert!(log.iter().all(|s| s.line_search_halvings > 0 && s.iterations > 2));
+    assert!(reported > 2 * 7 * points * 3, "{reported} for {points} points");
+}

@@ -70,7 +70,9 @@ pub struct Summary {
     pub displacement: f64,
     /// F_u, F_res, E, E50 of the curve so far.
     pub metrics: CurveMetrics,
-    /// DEM steps summed over every Gauss point and converged step (0 for analytical materials).
+    /// DEM steps summed over every Gauss point and every relaxation of the converged steps:
+    /// all Newton iterations, line-search trials and cut attempts that answered, the
+    /// run's relaxation cost (0 for analytical materials).
     pub dem_steps: u64,
     /// Gauss-point relaxations that hit their step cap in converged steps.
     pub capped_relaxations: u64,
@@ -344,7 +346,7 @@ impl StepObserver for RunWriter {
         let displacement = report.load_factor * self.settings.shortening;
         let load = -self.settings.load_scale
             * report.reactions.get(&self.settings.load_set).map_or(0.0, |r| r[1]);
-        let dem_steps: u64 = view.gauss_points.iter().map(|g| g.diagnostics.steps).sum();
+        let dem_steps = report.dem_steps;
         let capped = view
             .gauss_points
             .iter()

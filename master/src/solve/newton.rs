@@ -234,6 +234,9 @@ pub struct Solver {
     states: Vec<GaussPointState>,
     /// Reactions at the converged state.
     reactions: BTreeMap<String, [f64; 3]>,
+    /// DEM steps of every evaluation since the last converged step (all iterations, line
+    /// search trials and cut attempts that answered): the step's real relaxation cost.
+    evaluated_steps: std::cell::Cell<u64>,
 }
 
 fn norm(v: &[f64]) -> f64 {
@@ -290,6 +293,7 @@ impl Solver {
             committed: None,
             states,
             reactions: BTreeMap::new(),
+            evaluated_steps: std::cell::Cell::new(0),
         })
     }
 
@@ -442,6 +446,7 @@ impl Solver {
                         cuts,
                         tolerated,
                         reactions: self.reactions.clone(),
+                        dem_steps: self.evaluated_steps.take(),
                     };
                     if tolerated {
                         let residual = report.residuals.last().copied().unwrap_or(f64::NAN);
@@ -499,6 +504,8 @@ impl Solver {
                 Err(Error::ResponseCount { expected: inputs.len(), got: r.len() })
             }
             Ok(r) => {
+                let steps = r.iter().fold(0u64, |a, x| a.saturating_add(x.diagnostics.steps));
+                self.evaluated_steps.set(self.evaluated_steps.get().saturating_add(steps));
                 let bad: Vec<_> = r
                     .iter()
                     .zip(&inputs)

@@ -32,6 +32,9 @@ pub struct StepReport {
     /// Reaction `[R_x, R_y, R_w]` (N, N, N m per metre of thickness) of every named node set:
     /// the sum of `f_int - f_ext` over the set's dofs.
     pub reactions: BTreeMap<String, [f64; 3]>,
+    /// DEM steps of every relaxation of the step: all its Newton iterations, line-search
+    /// trials and cut attempts that answered (the converged state's own are a part).
+    pub dem_steps: u64,
 }
 
 /// State of one Gauss point at a converged step.
