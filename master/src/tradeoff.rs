@@ -210,7 +210,8 @@ fn with(base: &Job, knob: &'static str, setting: impl ToString, f: impl Fn(&mut 
 }
 
 /// The reference: the job's scene with tight settings (relaxation tolerance 1e-5, time-step
-/// safety 0.25, no mass scaling, Cundall damping, half the load step, cold starts) and the
+/// safety 0.25, no mass scaling, Cundall damping, half the load step, cold starts, no
+/// skipped or linear answers) and the
 /// job's tangent (the paper's for a sliding-aware one): a job past a peak needs the
 /// perturbation or adaptive tangent to converge at all (the paper tangent stays elastic while
 /// the assemblies soften and Newton stalls), a pre-peak job keeps the paper tangent. The
@@ -237,6 +238,9 @@ pub fn reference(base: &Job) -> Variant {
                 a.tangent = TangentKind::Paper;
             }
             a.warm_start = false;
+            // Every Gauss point relaxed at every evaluation.
+            a.relaxation.skip_below = 0.0;
+            a.relaxation.elastic_shortcut = false;
         }
     })
 }
@@ -306,6 +310,23 @@ pub fn variants(base: &Job) -> Vec<Variant> {
             a.warm_start = true;
         }
     }));
+    // Item 3's skipping: a point deformed less than the threshold since its last relaxation
+    // answers from its tangent (1e-3: a tenth to a half of these scenes' strain per step);
+    // the elastic shortcut answers from the tangent while every contact sticks.
+    if a.relaxation.skip_below == 0.0 {
+        v.push(with(base, "relaxation.skip_below", "1e-3", |j| {
+            if let Some(a) = assembly_mut(j) {
+                a.relaxation.skip_below = 1e-3;
+            }
+        }));
+    }
+    if !a.relaxation.elastic_shortcut {
+        v.push(with(base, "relaxation.elastic_shortcut", "true", |j| {
+            if let Some(a) = assembly_mut(j) {
+                a.relaxation.elastic_shortcut = true;
+            }
+        }));
+    }
     if let PackingSpec::Hexagonal { radius, side } = a.packing {
         for f in [0.5, 0.75] {
             let s = (side * f).max(8.0 * radius);
@@ -505,6 +526,7 @@ pub fn read_csv(text: &str, origin: &str) -> Result<Vec<Row>, TableError> {
 /// `x2`/`x4` (any `xF`: the load step times F), `relaxation.tolerance`, `relaxation.safety`,
 /// `relaxation.density_scale` (numbers), `relaxation.driver` `fire`/`cundall`, `tangent`
 /// `sliding_aware`/`paper`/`perturbation` (strain 1e-5), `warm_start` `true`/`false`,
+/// `relaxation.skip_below` (a number), `relaxation.elastic_shortcut` `true`/`false`,
 /// `assembly.side` (m). The same moves as [`variants`] (a test checks they agree). An
 /// analytical material has only the load step.
 pub fn apply_setting(job: &mut Job, knob: &str, setting: &str) -> Result<(), TableError> {
@@ -534,6 +556,9 @@ pub fn apply_setting(job: &mut Job, knob: &str, setting: &str) -> Result<(), Tab
         ("tangent", "paper") => a.tangent = TangentKind::Paper,
         ("tangent", "perturbation") => a.tangent = TangentKind::Perturbation { strain: 1e-5 },
         ("warm_start", "true") => a.warm_start = true,
+        ("relaxation.skip_below", _) => a.relaxation.skip_below = number().ok_or_else(unknown)?,
+        ("relaxation.elastic_shortcut", "true") => a.relaxation.elastic_shortcut = true,
+        ("relaxation.elastic_shortcut", "false") => a.relaxation.elastic_shortcut = false,
         ("warm_start", "false") => a.warm_start = false,
         ("assembly.side", _) => {
             let s = number().ok_or_else(unknown)?;
@@ -563,6 +588,16 @@ fn point_label(r: &Row) -> String {
     match r.knob.as_str() {
         "reference" => "reference (tight)".into(),
         "default" => "default (job as given)".into(),
+        // Combinations name their knobs in the table; the plot says only what they are.
+        "accuracy" | "cheapest" => {
+            let failed = if finished(r) { "" } else { " (failed)" };
+            let target = r.setting.split(':').next().unwrap_or("");
+            if r.knob == "cheapest" {
+                format!("cheapest set{failed}")
+            } else {
+                format!("accuracy {target} pick{failed}")
+            }
+        }
         k => {
             let k = k.strip_prefix("relaxation.").unwrap_or(k);
             let failed = if finished(r) { "" } else { " (failed)" };
@@ -607,6 +642,12 @@ pub const PARETO_FILE: &str = "pareto.png";
 /// long sweep can be read as it goes. `progress` hears each finished row. The reference runs
 /// first. The job's `accuracy` key, if any, is dropped: it would move the very knobs the
 /// sweep measures.
+///
+/// After the one-knob rows, a DEM job gets the rows that move several knobs at once, planned
+/// from this sweep's own rows by [`crate::accuracy`]: `accuracy` 0.05, 0.1 and 0.2 (what
+/// those targets pick: the measured check of the prediction) and `cheapest` (every knob at
+/// its cheapest candidate setting, whatever the predicted error: where the knobs end). A
+/// combination that moves no knob, or the same knobs as an earlier one, is not run again.
 pub fn sweep(
     base: &Job,
     title: &str,
@@ -623,40 +664,115 @@ pub fn sweep(
     variants.retain(|v| !skipped(v, skip));
     variants.insert(0, reference_variant);
     let mut rows: Vec<Row> = Vec::new();
-    // The reference's metrics, curve and wall time (the first run).
-    type Reference = (CurveMetrics, Vec<(f64, f64)>, f64);
     let mut reference: Option<Reference> = None;
     for v in &variants {
-        let dir = out.join("runs").join(v.slug());
-        let (summary, curve) = crate::run::run_job(&v.job, &dir, workers)?;
-        let (rm, rc, rt) =
-            reference.get_or_insert_with(|| (summary.metrics, curve.clone(), summary.wall_seconds));
-        let row = Row {
-            knob: v.knob.to_string(),
-            setting: v.setting.clone(),
-            status: summary.status.clone(),
-            displacement: summary.displacement,
-            wall_seconds: summary.wall_seconds,
-            dem_steps: summary.dem_steps,
-            cuts: summary.cuts,
-            metrics: summary.metrics,
-            errors: compare((rm, rc), (&summary.metrics, &curve)),
-            speedup: *rt / summary.wall_seconds.max(1e-9),
-        };
+        let row = run_variant(v, out, workers, &mut reference)?;
         progress(&row);
         rows.push(row);
-        let write = |name: &str, text: String| {
-            let path = out.join(name);
-            crate::output::write_atomic(&path, text.as_bytes())
-        };
-        write("tradeoff.csv", csv(&rows))?;
-        write("tradeoff.md", markdown(title, &rows))?;
-        // A figure that cannot be drawn is a warning, never a failed sweep.
-        if let Err(e) = write_pareto(&rows, title, &out.join(PARETO_FILE)) {
-            tracing::warn!(error = %e, "pareto plot not written");
+        write_tables(&rows, title, out)?;
+    }
+    for v in combinations(&base, &rows)? {
+        if skipped(&v, skip) {
+            continue;
         }
+        let row = run_variant(&v, out, workers, &mut reference)?;
+        progress(&row);
+        rows.push(row);
+        write_tables(&rows, title, out)?;
     }
     Ok(rows)
+}
+
+/// The reference's metrics, curve and wall time (the sweep's first run).
+type Reference = (CurveMetrics, Vec<(f64, f64)>, f64);
+
+/// Runs one variant into `out/runs/<slug>` and compares it with the reference (the first
+/// run becomes the reference).
+fn run_variant(
+    v: &Variant,
+    out: &std::path::Path,
+    workers: &crate::run::WorkerChoice,
+    reference: &mut Option<Reference>,
+) -> Result<Row, crate::run::RunError> {
+    let dir = out.join("runs").join(v.slug());
+    let (summary, curve) = crate::run::run_job(&v.job, &dir, workers)?;
+    let (rm, rc, rt) =
+        reference.get_or_insert_with(|| (summary.metrics, curve.clone(), summary.wall_seconds));
+    Ok(Row {
+        knob: v.knob.to_string(),
+        setting: v.setting.clone(),
+        status: summary.status.clone(),
+        displacement: summary.displacement,
+        wall_seconds: summary.wall_seconds,
+        dem_steps: summary.dem_steps,
+        cuts: summary.cuts,
+        metrics: summary.metrics,
+        errors: compare((rm, rc), (&summary.metrics, &curve)),
+        speedup: *rt / summary.wall_seconds.max(1e-9),
+    })
+}
+
+/// Rewrites the sweep's CSV, Markdown table and Pareto plot.
+fn write_tables(
+    rows: &[Row],
+    title: &str,
+    out: &std::path::Path,
+) -> Result<(), crate::run::RunError> {
+    let write = |name: &str, text: String| {
+        let path = out.join(name);
+        crate::output::write_atomic(&path, text.as_bytes())
+    };
+    write("tradeoff.csv", csv(rows))?;
+    write("tradeoff.md", markdown(title, rows))?;
+    // A figure that cannot be drawn is a warning, never a failed sweep.
+    if let Err(e) = write_pareto(rows, title, &out.join(PARETO_FILE)) {
+        tracing::warn!(error = %e, "pareto plot not written");
+    }
+    Ok(())
+}
+
+/// The accuracy targets whose picks the sweep runs.
+pub const CHECKED_TARGETS: [f64; 3] = [0.05, 0.1, 0.2];
+
+/// The combination rows of a sweep of `base` from its one-knob `rows` (see [`sweep`]):
+/// planned with [`crate::accuracy::plan`] and [`crate::accuracy::cheapest`] from a trade
+/// whose default is `base` itself. None for an analytical material, or when the reference or
+/// the default did not finish (there is no trade to plan from).
+pub fn combinations(base: &Job, rows: &[Row]) -> Result<Vec<Variant>, crate::run::RunError> {
+    use crate::accuracy::{Trade, cheapest, plan};
+    let MaterialSection::Dem { assembly } = &base.material else { return Ok(Vec::new()) };
+    let kind = match assembly.packing {
+        PackingSpec::Hexagonal { .. } => "hexagonal",
+        PackingSpec::Random { .. } => "random",
+    };
+    let Ok(trade) = Trade::from_rows(rows.to_vec(), "this sweep", kind, Some((**assembly).clone()))
+    else {
+        return Ok(Vec::new());
+    };
+    let mut picks = Vec::new();
+    for t in CHECKED_TARGETS {
+        let mut job = base.clone();
+        job.accuracy = Some(t);
+        picks.push(("accuracy", format!("{t}"), plan(&job, &trade, &[])?));
+    }
+    picks.push(("cheapest", String::new(), cheapest(base, &trade)?));
+    let mut seen: Vec<Vec<String>> = Vec::new();
+    let mut out = Vec::new();
+    for (knob, target, p) in picks {
+        let Some(p) = p else { continue };
+        let moved: Vec<String> = p.report.knobs.iter().filter_map(|k| k.row.clone()).collect();
+        if moved.is_empty() || seen.contains(&moved) {
+            continue;
+        }
+        let setting = if target.is_empty() {
+            moved.join("+")
+        } else {
+            format!("{target}: {}", moved.join("+"))
+        };
+        seen.push(moved);
+        out.push(Variant { knob, setting, job: p.job });
+    }
+    Ok(out)
 }
 
 #[cfg(test)]
@@ -725,22 +841,39 @@ mod tests {
         assert_eq!(Errors::default().worst_present(), None);
     }
 
-    /// The committed sweeps read back: every row, the failed one included, and a non-empty
-    /// Pareto front although no row has F_res (the table used to have an empty column).
+    /// The committed sweeps read back: every row, the failed ones included, and a non-empty
+    /// Pareto front, with or without F_res (a pre-peak table has an empty column).
     #[test]
     fn committed_tables_read_back_with_a_front() {
-        for (name, text) in [
-            ("tradeoff-scene-a.csv", include_str!("../../docs/tradeoff-scene-a.csv")),
-            ("tradeoff-scene-a-0.06.csv", include_str!("../../docs/tradeoff-scene-a-0.06.csv")),
+        // (name, text, rows, failed rows, has F_res)
+        for (name, text, count, failed, has_residual) in [
+            ("tradeoff-scene-a.csv", include_str!("../../docs/tradeoff-scene-a.csv"), 19, 1, false),
+            (
+                "tradeoff-scene-a-0.06.csv",
+                include_str!("../../docs/tradeoff-scene-a-0.06.csv"),
+                15,
+                1,
+                false,
+            ),
+            ("tradeoff-biaxial.csv", include_str!("../../docs/tradeoff-biaxial.csv"), 19, 0, false),
+            (
+                "tradeoff-scene-a-post-peak.csv",
+                include_str!("../../docs/tradeoff-scene-a-post-peak.csv"),
+                14,
+                5,
+                true,
+            ),
         ] {
             let rows = read_csv(text, name).unwrap();
-            assert_eq!(rows.len(), 15, "{name}");
+            assert_eq!(rows.len(), count, "{name}");
             assert_eq!(rows[0].knob, "reference");
             assert_eq!(rows[0].errors.peak, Some(0.0));
-            assert!(rows.iter().all(|r| r.errors.residual.is_none()), "{name}");
-            assert_eq!(rows.iter().filter(|r| !finished(r)).count(), 1, "{name}");
+            assert!(rows.iter().all(|r| r.errors.residual.is_some() == has_residual), "{name}");
+            assert_eq!(rows.iter().filter(|r| !finished(r)).count(), failed, "{name}");
             let front = pareto_front(&rows);
-            assert!(front.contains(&0), "{name}: the reference (zero error) is on the front");
+            // The reference (zero error) is on the front where it finished (past the peak
+            // it stopped at 0.117 of 0.12 m: the yardstick of the rows all the same).
+            assert_eq!(front.contains(&0), finished(&rows[0]), "{name}");
             assert!(front.len() >= 2, "{name}: {front:?}");
             assert!(front.iter().all(|&i| finished(&rows[i])));
             // Writing and reading again gives the same rows (up to the CSV's precision).
@@ -850,6 +983,8 @@ mod tests {
             "relaxation.driver",
             "tangent",
             "warm_start",
+            "relaxation.skip_below",
+            "relaxation.elastic_shortcut",
             "assembly.side",
         ] {
             assert!(knobs.contains(k), "{k} missing");
@@ -860,5 +995,77 @@ mod tests {
         }
         let slugs: std::collections::BTreeSet<_> = v.iter().map(Variant::slug).collect();
         assert_eq!(slugs.len(), v.len(), "slugs must be unique (run directories)");
+    }
+
+    /// The combination rows of a sweep are planned from the sweep's own rows, with the job
+    /// itself as the default (its perturbation tangent is kept, not reset to the worker's
+    /// paper tangent). Shifts from the default (F_u): x4 4 %, tolerance 1 %, safety 0.8 0,
+    /// FIRE 10 %, warm start 2 %, on a default 0.5 % off. A 5 % target (budget 2.5 %) moves
+    /// tolerance and safety (1.5 %), 10 % (5 %) adds warm start (3.5 %, DEM steps x0.135,
+    /// cheaper than x4 with safety at x0.144), 20 % (10 %) adds x4 (7.5 %), and the cheapest
+    /// set swaps safety for FIRE (17.5 %: within no budget but its own) and never takes both
+    /// (they set the same time step). Safety 0.95 is never a candidate. A combination that
+    /// moves no knob, or the same knobs as an earlier one, is not run.
+    #[test]
+    fn combinations_are_planned_from_the_sweep() {
+        let mut job =
+            Job::from_toml(include_str!("../../examples/rve-size.toml"), "rve-size").unwrap();
+        job.accuracy = Some(0.3);
+        let csv = "knob,setting,status,displacement,wall_seconds,speedup,dem_steps,cuts,\
+                   peak_load,residual_load,stiffness,err_peak,err_residual,err_stiffness,err_curve\n\
+                   reference,tight,finished,1,1,1,1000,0,100,5,10,0,0,0,0\n\
+                   default,as given,finished,1,1,1,100,0,100.5,5,10,0.005,0,0,0\n\
+                   load_step,x4,finished,1,1,1,32,0,104.5,5,10,0.045,0,0,0\n\
+                   relaxation.tolerance,1e-3,finished,1,1,1,50,0,101.5,5,10,0.015,0,0,0\n\
+                   relaxation.safety,0.95,finished,1,1,1,20,0,100.5,5,10,0.005,0,0,0\n\
+                   relaxation.safety,0.8,finished,1,1,1,45,0,100.5,5,10,0.005,0,0,0\n\
+                   relaxation.driver,fire,finished,1,1,1,40,0,110.5,5,10,0.105,0,0,0\n\
+                   warm_start,true,finished,1,1,1,60,0,102.5,5,10,0.025,0,0,0\n";
+        let rows = read_csv(csv, "made-up").unwrap();
+        let v = combinations(&job, &rows).unwrap();
+        let names: Vec<_> = v.iter().map(|v| (v.knob, v.setting.as_str())).collect();
+        assert_eq!(
+            names,
+            [
+                ("accuracy", "0.05: relaxation.tolerance=1e-3+relaxation.safety=0.8"),
+                (
+                    "accuracy",
+                    "0.1: relaxation.tolerance=1e-3+relaxation.safety=0.8+warm_start=true"
+                ),
+                (
+                    "accuracy",
+                    "0.2: load_step=x4+relaxation.tolerance=1e-3+relaxation.safety=0.8+warm_start=true"
+                ),
+                (
+                    "cheapest",
+                    "load_step=x4+relaxation.tolerance=1e-3+relaxation.driver=fire+warm_start=true"
+                ),
+            ]
+        );
+        for c in &v {
+            assert_eq!(c.job.accuracy, None, "a planned job is run as planned");
+            assert_eq!(c.job.mesh, job.mesh);
+            let Some(a) = assembly_of(&c.job) else { panic!("DEM job") };
+            assert!(matches!(a.tangent, TangentKind::Perturbation { .. }), "{:?}", a.tangent);
+            let fire = matches!(a.relaxation.driver, Driver::Fire { .. });
+            assert!(a.relaxation.safety <= 0.8 && !(fire && a.relaxation.safety != 0.5));
+        }
+        let inc = |j: &Job| j.loading.increment.unwrap();
+        assert_eq!(inc(&v[2].job), 4.0 * inc(&job));
+        assert_eq!(inc(&v[0].job), inc(&job));
+        // Only the reference and the default: nothing to move, nothing run. No reference:
+        // no trade. An analytical material: no knobs.
+        assert!(combinations(&job, &rows[..2]).unwrap().is_empty());
+        assert!(combinations(&job, &rows[2..]).unwrap().is_empty());
+        let elastic =
+            Job::from_toml(include_str!("../../examples/elastic.toml"), "elastic").unwrap();
+        assert!(combinations(&elastic, &rows).unwrap().is_empty());
+    }
+
+    fn assembly_of(job: &Job) -> Option<&cosdem_worker::AssemblySpec> {
+        match &job.material {
+            MaterialSection::Dem { assembly } => Some(assembly),
+            MaterialSection::Elastic { .. } => None,
+        }
     }
 }

@@ -359,6 +359,15 @@ pub fn rve_size(job: &Job, settings: &RveSizeSettings, dir: &Path) -> Result<Rve
     let runs = runs.into_iter().collect::<Result<Vec<_>>>()?;
     let study = fit_runs(runs, settings.tolerance);
     write_study(&study, dir)?;
+    let sizes: Vec<String> = settings.sizes.iter().map(|v| fmt_f64(*v)).collect();
+    let source = format!("cosdem study rve-size ({}) --sizes {}", job.title, sizes.join(","));
+    if let Some(fit) = size_fit(&study, job, source) {
+        let json =
+            serde_json::to_string_pretty(&fit).map_err(|e| Error::Observer(e.to_string()))?;
+        let path = dir.join(SIZE_FIT_FILE);
+        write_atomic(&path, format!("{json}\n").as_bytes())
+            .map_err(|e| Error::Observer(format!("{}: {e}", path.display())))?;
+    }
     for (figure, e) in plot_study(&study, dir, &job.title) {
         tracing::warn!(figure, error = %e, "study figure not drawn");
     }
@@ -417,6 +426,39 @@ pub fn plot_study(
         }
     }
     failed
+}
+
+/// The file of [`size_fit`] in a study's directory.
+pub const SIZE_FIT_FILE: &str = "size-fit.json";
+
+/// The study's fits in the form an accuracy target reads them ([`crate::accuracy::SizeFit`],
+/// committed under `docs/` and listed in [`crate::accuracy::SIZE_FITS`]): per fitted
+/// property its `k`, `a`, `b*` and the upper end of `b*`'s 95 % interval, with the job's
+/// assembly and the sizes run. `None` for a job without a DEM material.
+pub fn size_fit(
+    study: &RveSizeStudy,
+    job: &Job,
+    source: String,
+) -> Option<crate::accuracy::SizeFit> {
+    use crate::accuracy::{LawParams, SizeFit};
+    let MaterialSection::Dem { assembly } = &job.material else { return None };
+    let law = |f: &FitOutcome| match f {
+        FitOutcome::Fitted(f) => Some(LawParams {
+            k: f.k,
+            a: f.a.value,
+            b_star: f.b_star.value,
+            b_star_high: f.b_star.high,
+        }),
+        FitOutcome::Failed { .. } => None,
+    };
+    Some(SizeFit {
+        source,
+        assembly: (**assembly).clone(),
+        sizes: study.runs.iter().map(|r| r.size).collect(),
+        peak_load: law(&study.peak_load),
+        residual_load: law(&study.residual_load),
+        stiffness: law(&study.stiffness),
+    })
 }
 
 /// Reads a study's `study.json` back (for redrawing its figures).

@@ -73,6 +73,13 @@ fn three_tiny_sizes_run_deterministically_and_write_files() {
     assert!(json.contains("peak_load") && json.contains("stiffness_50"), "{json}");
     // study.json reads back into the same study (what `cosdem plot DIR` redraws from).
     assert_eq!(read_study(&d1).unwrap().runs, a.runs);
+    // size-fit.json is the study's fit in the accuracy target's form, for the job's assembly
+    // (compared as text: serde_json's float parsing is not bit-exact on the way back).
+    let text = std::fs::read_to_string(d1.join(SIZE_FIT_FILE)).unwrap();
+    let fit: crate::accuracy::SizeFit = serde_json::from_str(&text).unwrap();
+    assert_eq!(fit.sizes, one.sizes);
+    let made = size_fit(&a, &job, fit.source).unwrap();
+    assert_eq!(text, format!("{}\n", serde_json::to_string_pretty(&made).unwrap()));
     // Reusing the curves gives the same runs but for the (unknown) wall time.
     let reuse = RveSizeSettings { reuse: true, ..one.clone() };
     let c = rve_size(&job, &reuse, &d1).unwrap();
@@ -122,4 +129,21 @@ fn symmetric_meshes_report_the_whole_panel_load() {
     assert!(rel(h.metrics.peak_load, f.metrics.peak_load) < 1e-2, "{h:?} vs {f:?}");
     let (hs, fs) = (h.metrics.stiffness.unwrap(), f.metrics.stiffness.unwrap());
     assert!(rel(hs, fs) < 1e-2, "E {hs} vs {fs}");
+}
+
+/// The committed size fit the accuracy target reads is what `size_fit` makes of the
+/// committed study (`docs/paper/rve-size-study.json`) and its job (`examples/rve-size.toml`):
+/// the same laws to the bit, the same assembly and sizes. A hand edit of either file, or a
+/// study whose fits changed without the committed fit, fails here.
+#[test]
+fn committed_size_fit_is_the_study_s() {
+    let study: RveSizeStudy =
+        serde_json::from_str(include_str!("../../../docs/paper/rve-size-study.json")).unwrap();
+    let job = Job::from_toml(include_str!("../../../examples/rve-size.toml"), "rve-size").unwrap();
+    let committed: crate::accuracy::SizeFit =
+        serde_json::from_str(include_str!("../../../docs/rve-size-scene-a-quarter.json")).unwrap();
+    let made = size_fit(&study, &job, committed.source.clone()).unwrap();
+    assert_eq!(made, committed);
+    assert!(committed.stiffness.unwrap().has_plateau());
+    assert!(!committed.peak_load.unwrap().has_plateau());
 }
