@@ -143,32 +143,34 @@ fn cholesky_and_lu_paths_agree() {
     }
 }
 
-/// Elastic stresses but a tangent scaled by 0.4: each full Newton update on a pressure load
-/// overshoots 2.5 times, so the residual grows (r -> -1.5 r); the line search halves the
-/// update (r -> -0.25 r) and the run converges, linearly. Printed: halvings and iterations.
-#[test]
-fn line_search_engages_when_the_residual_grows() {
-    struct SoftTangent(ElasticCosserat);
-    impl cosdem_master::material::Material for SoftTangent {
-        fn evaluate(
-            &mut self,
-            trial: cosdem_master::material::TrialId,
-            inputs: &[cosdem_master::material::MaterialInput],
-        ) -> Result<Vec<cosdem_common::MicroResponse>, cosdem_master::material::MaterialError>
-        {
-            let mut r = self.0.evaluate(trial, inputs)?;
-            for x in &mut r {
-                x.tangent = x.tangent.map(|row| row.map(|v| 0.4 * v));
-            }
-            Ok(r)
+/// Elastic stresses, the tangent scaled by 0.4, and 7 DEM steps reported per Gauss point
+/// per evaluation (`.1` sums them: what the solver was asked to relax).
+struct SoftTangent(ElasticCosserat, u64);
+
+impl cosdem_master::material::Material for SoftTangent {
+    fn evaluate(
+        &mut self,
+        trial: cosdem_master::material::TrialId,
+        inputs: &[cosdem_master::material::MaterialInput],
+    ) -> Result<Vec<cosdem_common::MicroResponse>, cosdem_master::material::MaterialError> {
+        let mut r = self.0.evaluate(trial, inputs)?;
+        for x in &mut r {
+            x.tangent = x.tangent.map(|row| row.map(|v| 0.4 * v));
+            x.diagnostics.steps = 7;
         }
-        fn commit(&mut self, _: u64) -> Result<(), cosdem_master::material::MaterialError> {
-            Ok(())
-        }
-        fn rollback(&mut self) -> Result<(), cosdem_master::material::MaterialError> {
-            Ok(())
-        }
+        self.1 += 7 * r.len() as u64;
+        Ok(r)
     }
+    fn commit(&mut self, _: u64) -> Result<(), cosdem_master::material::MaterialError> {
+        Ok(())
+    }
+    fn rollback(&mut self) -> Result<(), cosdem_master::material::MaterialError> {
+        Ok(())
+    }
+}
+
+/// The panel held at the bottom under a 1e5 Pa pressure on its top.
+fn top_pressure_panel() -> Model {
     let mut model = panel(0.0);
     model.loading.dirichlet.retain(|d| d.set == "bottom");
     model.loading.edge_loads.push(cosdem_master::solve::EdgeLoad {
@@ -176,10 +178,19 @@ fn line_search_engages_when_the_residual_grows() {
         kind: cosdem_master::solve::EdgeLoadKind::Pressure(1e5),
         ramp: cosdem_master::solve::Ramp::Linear,
     });
+    model
+}
+
+/// Elastic stresses but a tangent scaled by 0.4: each full Newton update on a pressure load
+/// overshoots 2.5 times, so the residual grows (r -> -1.5 r); the line search halves the
+/// update (r -> -0.25 r) and the run converges, linearly. Printed: halvings and iterations.
+#[test]
+fn line_search_engages_when_the_residual_grows() {
+    let model = top_pressure_panel();
     let settings = SolverSettings { steps: 1, max_iterations: 40, ..Default::default() };
     let mut solver = Solver::new(model, settings).unwrap();
     let mut log: Vec<StepReport> = Vec::new();
-    solver.run(&mut SoftTangent(elastic()), &mut log).unwrap();
+    solver.run(&mut SoftTangent(elastic(), 0), &mut log).unwrap();
     let s = &log[0];
     println!(
         "halvings {} iterations {} residuals {:?}",
@@ -266,46 +277,17 @@ fn tolerated_residual_accepts_steps_that_ran_out_of_iterations() {
 
 /// A step's `dem_steps` is the cost of every relaxation of the step: each evaluation the
 /// solver asks for (the predictor's, every Newton iteration, every line-search trial), not
-/// only the converged one. The material here reports 7 DEM steps per Gauss point per
-/// evaluation and counts its evaluations; its tangent is scaled by 0.4 so the step takes
-/// line-search halvings and several iterations (a count of the converged evaluation alone
+/// only the converged one. [`SoftTangent`] reports 7 DEM steps per Gauss point per
+/// evaluation and counts them; its soft tangent makes each step take line-search halvings
+/// and several iterations (a count of the converged evaluation alone
 /// would be 7 x points per step, far below the sum).
 #[test]
 fn dem_steps_count_every_evaluation() {
-    struct Counting(ElasticCosserat, u64);
-    impl cosdem_master::material::Material for Counting {
-        fn evaluate(
-            &mut self,
-            trial: cosdem_master::material::TrialId,
-            inputs: &[cosdem_master::material::MaterialInput],
-        ) -> Result<Vec<cosdem_common::MicroResponse>, cosdem_master::material::MaterialError>
-        {
-            let mut r = self.0.evaluate(trial, inputs)?;
-            for x in &mut r {
-                x.tangent = x.tangent.map(|row| row.map(|v| 0.4 * v));
-                x.diagnostics.steps = 7;
-            }
-            self.1 += 7 * r.len() as u64;
-            Ok(r)
-        }
-        fn commit(&mut self, _: u64) -> Result<(), cosdem_master::material::MaterialError> {
-            Ok(())
-        }
-        fn rollback(&mut self) -> Result<(), cosdem_master::material::MaterialError> {
-            Ok(())
-        }
-    }
-    let mut model = panel(0.0);
-    model.loading.dirichlet.retain(|d| d.set == "bottom");
-    model.loading.edge_loads.push(cosdem_master::solve::EdgeLoad {
-        set: "top".into(),
-        kind: cosdem_master::solve::EdgeLoadKind::Pressure(1e5),
-        ramp: cosdem_master::solve::Ramp::Linear,
-    });
+    let model = top_pressure_panel();
     let settings = SolverSettings { steps: 2, max_iterations: 40, ..Default::default() };
     let mut solver = Solver::new(model, settings).unwrap();
     let mut log: Vec<StepReport> = Vec::new();
-    let mut material = Counting(elastic(), 0);
+    let mut material = SoftTangent(elastic(), 0);
     solver.run(&mut material, &mut log).unwrap();
     let points = solver.solution().gauss_points.len() as u64;
     let reported: u64 = log.iter().map(|s| s.dem_steps).sum();
