@@ -189,10 +189,12 @@ impl PropertyErrors {
         }
     }
 
-    fn describe(&self) -> String {
+    /// In words; a missing value is `missing` (`not measured` for the table's errors, `not
+    /// predicted` for the size law's).
+    fn describe(&self, missing: &str) -> String {
         let f = |name: &str, e: Option<f64>| match e {
             Some(e) => format!("{name} {:.3} %", 100.0 * e),
-            None => format!("{name} not measured"),
+            None => format!("{name} {missing}"),
         };
         format!(
             "{}, {}, {}",
@@ -389,8 +391,8 @@ impl Report {
         l.push(format!(
             "  predicted: {} (default settings alone: {}); DEM steps x{:.3} of the default \
              settings",
-            self.predicted.describe(),
-            self.default_error.describe(),
+            self.predicted.describe("not measured"),
+            self.default_error.describe("not measured"),
             self.predicted_dem_steps_ratio
         ));
         l.push(format!("  assembly size: {}", self.size.note));
@@ -608,7 +610,7 @@ fn size_report(
          the assembly size is kept as written (not part of the promise, which is against a \
          tight run of the same V)",
         fit.source,
-        predicted.describe()
+        predicted.describe("not predicted")
     );
     let warning = (predicted.worst() > target).then(|| {
         format!(
@@ -1157,6 +1159,7 @@ mod tests {
         let size = &committed.report.size;
         assert_eq!(size.fit.as_deref().map(|f| f.contains("rve-size")), Some(true));
         assert!(size.note.contains("F_u: no plateau established"), "{}", size.note);
+        assert!(size.note.contains("F_u not predicted, E 9.9"), "{}", size.note);
         let predicted = size.predicted.unwrap();
         assert_eq!(predicted.peak, None);
         assert_eq!(predicted.residual, None);
