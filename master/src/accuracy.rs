@@ -1003,8 +1003,8 @@ mod tests {
     #[test]
     fn measured_trade_reads() {
         let t = Trade::measured().unwrap();
-        // 16 one-knob rows and the accuracy-0.05 combination (not a candidate).
-        assert_eq!(t.settings.len(), 17);
+        // 17 one-knob rows and the accuracy-0.05 combination (not a candidate).
+        assert_eq!(t.settings.len(), 18);
         let e = t.default_error();
         assert_eq!(e.peak, Some(1.352609e-3));
         assert_eq!(e.stiffness, Some(2.350590e-3));

@@ -234,7 +234,7 @@ pub fn reference(base: &Job) -> Variant {
             a.relaxation.density_scale = 1.0;
             a.relaxation.driver = Driver::default();
             // Keep a tangent that follows softening (perturbation, adaptive); else the paper's.
-            if matches!(a.tangent, TangentKind::SlidingAware) {
+            if matches!(a.tangent, TangentKind::SlidingAware | TangentKind::Secant) {
                 a.tangent = TangentKind::Paper;
             }
             a.warm_start = false;
@@ -295,6 +295,7 @@ pub fn variants(base: &Job) -> Vec<Variant> {
     for (name, tangent) in [
         ("paper", TangentKind::Paper),
         ("sliding_aware", TangentKind::SlidingAware),
+        ("secant", TangentKind::Secant),
         ("perturbation", TangentKind::Perturbation { strain: 1e-5 }),
     ] {
         if std::mem::discriminant(&tangent) != std::mem::discriminant(&a.tangent) {
@@ -525,7 +526,7 @@ pub fn read_csv(text: &str, origin: &str) -> Result<Vec<Row>, TableError> {
 /// Moves one knob of `job` to a setting of the sweep, named as in the table: `load_step`
 /// `x2`/`x4` (any `xF`: the load step times F), `relaxation.tolerance`, `relaxation.safety`,
 /// `relaxation.density_scale` (numbers), `relaxation.driver` `fire`/`cundall`, `tangent`
-/// `sliding_aware`/`paper`/`perturbation` (strain 1e-5), `warm_start` `true`/`false`,
+/// `sliding_aware`/`paper`/`secant`/`perturbation` (strain 1e-5), `warm_start` `true`/`false`,
 /// `relaxation.skip_below` (a number), `relaxation.elastic_shortcut` `true`/`false`,
 /// `assembly.side` (m). The same moves as [`variants`] (a test checks they agree). An
 /// analytical material has only the load step.
@@ -553,6 +554,7 @@ pub fn apply_setting(job: &mut Job, knob: &str, setting: &str) -> Result<(), Tab
         ("relaxation.driver", "fire") => a.relaxation.driver = Driver::fire(),
         ("relaxation.driver", "cundall") => a.relaxation.driver = Driver::default(),
         ("tangent", "sliding_aware") => a.tangent = TangentKind::SlidingAware,
+        ("tangent", "secant") => a.tangent = TangentKind::Secant,
         ("tangent", "paper") => a.tangent = TangentKind::Paper,
         ("tangent", "perturbation") => a.tangent = TangentKind::Perturbation { strain: 1e-5 },
         ("warm_start", "true") => a.warm_start = true,
@@ -847,7 +849,7 @@ mod tests {
     fn committed_tables_read_back_with_a_front() {
         // (name, text, rows, failed rows, has F_res)
         for (name, text, count, failed, has_residual) in [
-            ("tradeoff-scene-a.csv", include_str!("../../docs/tradeoff-scene-a.csv"), 19, 1, false),
+            ("tradeoff-scene-a.csv", include_str!("../../docs/tradeoff-scene-a.csv"), 20, 1, false),
             (
                 "tradeoff-scene-a-0.06.csv",
                 include_str!("../../docs/tradeoff-scene-a-0.06.csv"),
@@ -855,7 +857,7 @@ mod tests {
                 1,
                 false,
             ),
-            ("tradeoff-biaxial.csv", include_str!("../../docs/tradeoff-biaxial.csv"), 19, 0, false),
+            ("tradeoff-biaxial.csv", include_str!("../../docs/tradeoff-biaxial.csv"), 20, 0, false),
             (
                 "tradeoff-scene-a-post-peak.csv",
                 include_str!("../../docs/tradeoff-scene-a-post-peak.csv"),

@@ -352,6 +352,17 @@ pub enum TangentKind {
     Paper,
     /// As `Paper` but `k_s' = 0` on sliding and `k_r' = 0` on saturated rolling contacts.
     SlidingAware,
+    /// `Paper` scaled by the assembly's secant ratio since its committed state: `s = (dsigma
+    /// . de) / (de . C de)` with `de` the strain (and curvature) increment from the committed
+    /// target, `dsigma` the stress (and couple stress) increment from the committed relaxed
+    /// answer and `C` the paper tangent, kept in [`SECANT_RANGE`]. The contact tangent
+    /// assumes affine motion and sticking contacts, an upper bound the relaxed random
+    /// assembly falls below (its contacts slide, its discs move non-affinely); the secant
+    /// measures by how much along the step's own path. `s = 1` (the paper tangent) when the
+    /// committed state was never relaxed, the increment is nil, or its second-order work is
+    /// not positive (`dsigma . de <= 0`, softening past a peak: no positive scale helps
+    /// there). Deterministic: it depends on the committed state and the trial only.
+    Secant,
     /// Central differences of extra relaxations from the trial state, which is restored.
     Perturbation {
         /// Strain perturbation (default 1e-5 in the job file; must be > 0).
@@ -371,6 +382,11 @@ pub enum TangentKind {
         strain: f64,
     },
 }
+
+/// The range of the [`TangentKind::Secant`] scale: never stiffer than the contact tangent,
+/// never softer than a twentieth of it (a near-zero secant would hand Newton a singular
+/// matrix).
+pub const SECANT_RANGE: (f64, f64) = (0.05, 1.0);
 
 /// Most discs one assembly may hold (a cap so that a typo in `side` or `radius`, or a hostile
 /// request, cannot ask a worker for 10^17 discs). The paper's largest assemblies hold a few
@@ -551,7 +567,7 @@ impl AssemblySpec {
                     return Err(invalid("tangent.sliding", sliding, "must be in [0, 1]"));
                 }
             }
-            TangentKind::Paper | TangentKind::SlidingAware => {}
+            TangentKind::Paper | TangentKind::SlidingAware | TangentKind::Secant => {}
         }
         Ok(())
     }

@@ -41,6 +41,7 @@ impl Assembly {
         let (tangent, tangent_steps) = match self.spec.tangent {
             TangentKind::Paper => (h.paper, 0),
             TangentKind::SlidingAware => (h.sliding_aware, 0),
+            TangentKind::Secant => (self.secant_tangent(&h.paper, &h.stress, target), 0),
             TangentKind::Perturbation { strain } => {
                 self.perturbation_tangent(&st, strain, rep.steps)?
             }
@@ -82,6 +83,28 @@ impl Assembly {
         });
         self.trial = Some(st);
         Ok(MicroResponse { stress: h.stress, tangent, diagnostics })
+    }
+
+    /// The paper tangent `paper` scaled by the secant ratio from the committed relaxed state
+    /// to the trial answer `stress` at `target` ([`TangentKind::Secant`]).
+    pub fn secant_tangent(
+        &self,
+        paper: &cosdem_common::Tangent,
+        stress: &cosdem_common::StressVector,
+        target: &MacroDeformation,
+    ) -> cosdem_common::Tangent {
+        let Some(c) = &self.committed.relaxed else { return *paper };
+        let (e1, e0) = (target.strain(), self.committed.target.strain());
+        let de: [f64; N] = std::array::from_fn(|i| e1[i] - e0[i]);
+        let work: f64 = (0..N).map(|i| (stress[i] - c.stress[i]) * de[i]).sum();
+        let elastic: f64 =
+            (0..N).map(|i| de[i] * (0..N).map(|j| paper[i][j] * de[j]).sum::<f64>()).sum();
+        if !(work > 0.0 && elastic > 0.0) {
+            return *paper;
+        }
+        let (lo, hi) = crate::spec::SECANT_RANGE;
+        let s = (work / elastic).clamp(lo, hi);
+        paper.map(|row| row.map(|v| s * v))
     }
 
     /// Homogenized stress, tangents and fabric of a state.
