@@ -61,7 +61,7 @@ use crate::job::{Job, MaterialSection};
 use crate::output::{OutputError, write_atomic};
 use crate::tradeoff::{Row, TableError, apply_setting, finished, read_csv};
 use cosdem_worker::AssemblySpec;
-use cosdem_worker::spec::{Driver, PackingSpec, RelaxationSpec, TangentKind};
+use cosdem_worker::spec::{Driver, PackingSpec};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -496,29 +496,16 @@ fn size_key(a: &AssemblySpec) -> AssemblySpec {
 /// The table's default values of the assembly's speed knobs: `base`'s, or the worker's
 /// defaults (a committed table's default row).
 fn reset_knobs(a: &mut AssemblySpec, base: Option<&AssemblySpec>) {
-    match base {
-        Some(b) => {
-            a.relaxation.tolerance = b.relaxation.tolerance;
-            a.relaxation.safety = b.relaxation.safety;
-            a.relaxation.density_scale = b.relaxation.density_scale;
-            a.relaxation.driver = b.relaxation.driver.clone();
-            a.tangent = b.tangent.clone();
-            a.warm_start = b.warm_start;
-            a.relaxation.skip_below = b.relaxation.skip_below;
-            a.relaxation.elastic_shortcut = b.relaxation.elastic_shortcut;
-        }
-        None => {
-            let d = RelaxationSpec::default();
-            a.relaxation.tolerance = d.tolerance;
-            a.relaxation.safety = d.safety;
-            a.relaxation.density_scale = d.density_scale;
-            a.relaxation.driver = Driver::default();
-            a.tangent = TangentKind::Paper;
-            a.warm_start = false;
-            a.relaxation.skip_below = d.skip_below;
-            a.relaxation.elastic_shortcut = d.elastic_shortcut;
-        }
-    }
+    let defaults = AssemblySpec::default();
+    let b = base.unwrap_or(&defaults);
+    a.relaxation.tolerance = b.relaxation.tolerance;
+    a.relaxation.safety = b.relaxation.safety;
+    a.relaxation.density_scale = b.relaxation.density_scale;
+    a.relaxation.driver = b.relaxation.driver.clone();
+    a.relaxation.skip_below = b.relaxation.skip_below;
+    a.relaxation.elastic_shortcut = b.relaxation.elastic_shortcut;
+    a.tangent = b.tangent.clone();
+    a.warm_start = b.warm_start;
 }
 
 /// Knobs of rows that move several knobs at once (the sweep's checks of the prediction,
@@ -892,7 +879,7 @@ fn plan_within(
 }
 
 /// `hexagonal` or `random`.
-fn packing_kind(p: &PackingSpec) -> &'static str {
+pub(crate) fn packing_kind(p: &PackingSpec) -> &'static str {
     match p {
         PackingSpec::Hexagonal { .. } => "hexagonal",
         PackingSpec::Random { .. } => "random",

@@ -587,22 +587,18 @@ fn role(r: &Row) -> PointRole {
 
 /// The label of a row in the plot (`tolerance=1e-3`: the `relaxation.` prefix dropped).
 fn point_label(r: &Row) -> String {
+    let failed = if finished(r) { "" } else { " (failed)" };
     match r.knob.as_str() {
         "reference" => "reference (tight)".into(),
         "default" => "default (job as given)".into(),
         // Combinations name their knobs in the table; the plot says only what they are.
-        "accuracy" | "cheapest" => {
-            let failed = if finished(r) { "" } else { " (failed)" };
+        "cheapest" => format!("cheapest set{failed}"),
+        "accuracy" => {
             let target = r.setting.split(':').next().unwrap_or("");
-            if r.knob == "cheapest" {
-                format!("cheapest set{failed}")
-            } else {
-                format!("accuracy {target} pick{failed}")
-            }
+            format!("accuracy {target} pick{failed}")
         }
         k => {
             let k = k.strip_prefix("relaxation.").unwrap_or(k);
-            let failed = if finished(r) { "" } else { " (failed)" };
             format!("{k}={}{failed}", r.setting)
         }
     }
@@ -741,12 +737,9 @@ pub const CHECKED_TARGETS: [f64; 3] = [0.05, 0.1, 0.2];
 /// whose default is `base` itself. None for an analytical material, or when the reference or
 /// the default did not finish (there is no trade to plan from).
 pub fn combinations(base: &Job, rows: &[Row]) -> Result<Vec<Variant>, crate::run::RunError> {
-    use crate::accuracy::{Trade, cheapest, plan};
+    use crate::accuracy::{Trade, cheapest, packing_kind, plan};
     let MaterialSection::Dem { assembly } = &base.material else { return Ok(Vec::new()) };
-    let kind = match assembly.packing {
-        PackingSpec::Hexagonal { .. } => "hexagonal",
-        PackingSpec::Random { .. } => "random",
-    };
+    let kind = packing_kind(&assembly.packing);
     let Ok(trade) = Trade::from_rows(rows.to_vec(), "this sweep", kind, Some((**assembly).clone()))
     else {
         return Ok(Vec::new());

@@ -87,7 +87,7 @@ impl Assembly {
 
     /// The paper tangent `paper` scaled by the secant ratio from the committed relaxed state
     /// to the trial answer `stress` at `target` ([`TangentKind::Secant`]).
-    pub fn secant_tangent(
+    fn secant_tangent(
         &self,
         paper: &cosdem_common::Tangent,
         stress: &cosdem_common::StressVector,
