@@ -6,7 +6,7 @@
 //! The model is data: the committed sweep `docs/tradeoff-scene-a.csv` (`cosdem bench
 //! tradeoff`, scene A at V = 0.01 m^2 to 0.03 m, pre-peak), embedded with `include_str!` and
 //! read by [`crate::tradeoff::read_csv`]. Its "default" row is the job's own settings (the
-//! worker's defaults: relaxation tolerance 1e-4, time-step safety 0.5, no mass scaling,
+//! worker's defaults: relaxation tolerance 1e-4, time-step safety 0.8, no mass scaling,
 //! Cundall damping, paper tangent, cold starts) and every other row moves one knob.
 //!
 //! # The prediction, and why it is conservative (and where it is not)
@@ -43,8 +43,10 @@
 //! settings, with a warning. No table speaks for F_res: the post-peak sweep
 //! (`docs/tradeoff-scene-a-post-peak.md`, scene A to 0.12 m) found the collapse itself
 //! unconverged in the load step (the default 274 % off the tight reference on F_res, load
-//! step x4 70x, the reference failing at 0.117 m), so a plan predicts F_u and E and warns
-//! that F_res is not covered.
+//! step x4 70x, the reference failing at 0.117 m), and so did the whole biaxial example
+//! past its peak (`docs/tradeoff-biaxial.md`: the tight reference's F_res 13 % below the
+//! default's, every other row's 1.89-2.12e4 N, the load step moving it without a trend), so
+//! a plan predicts F_u and E and warns that F_res is not covered.
 //!
 //! # What it takes over, and the assembly size
 //! With `accuracy`, the knobs of [`KNOBS`] are set by the choice (to a measured setting or to
@@ -77,13 +79,18 @@ pub const TABLE_PACKING: &str = "hexagonal";
 pub const TABLE_NAME: &str = "docs/tradeoff-scene-a.csv";
 
 /// The measured sweep for random assemblies: the biaxial example (32 periodic 400-disc
-/// random assemblies, 100 kPa, to 1 % axial strain), measured with the specimen fixed
-/// across the knobs (before that rule the knobs changed the specimen and the table measured
-/// specimen scatter: 13-15 % on the test scene).
-pub const RANDOM_TABLE: &str = include_str!("../../docs/tradeoff-biaxial.csv");
+/// random assemblies, 100 kPa) to 1 % axial strain, before its peak, measured with the
+/// specimen fixed across the knobs (before that rule the knobs changed the specimen and the
+/// table measured specimen scatter: 13-15 % on the test scene). The whole example, past its
+/// peak to 5 %, is `docs/tradeoff-biaxial.csv`: it has F_res, but its tight reference is not
+/// converged in the load step there (every other row's F_res is 11-26 % above it, load step
+/// x2 and x4 included), so like scene A's post-peak table it is a measurement, not a model.
+/// The secant tangent is not in this table: it halves the Newton iterations to 1 % strain
+/// but stalls from 1.8 % on (20 iterations per step), so it is never picked.
+pub const RANDOM_TABLE: &str = include_str!("../../docs/tradeoff-biaxial-1mm.csv");
 
 /// Where [`RANDOM_TABLE`] lives in the repository.
-pub const RANDOM_TABLE_NAME: &str = "docs/tradeoff-biaxial.csv";
+pub const RANDOM_TABLE_NAME: &str = "docs/tradeoff-biaxial-1mm.csv";
 
 /// The predicted combined error must stay within this fraction of the target (the rest is
 /// left for what the prediction does not cover: other scenes, interactions of knobs).
@@ -115,9 +122,10 @@ pub const KNOBS: [&str; 9] = [
 /// Knobs that are never moved together: each group's knobs all set the relaxation's time
 /// step (safety scales it, FIRE grows it up to 1.8 times the base step that safety sets, mass
 /// scaling lengthens it), so moved together their effects multiply into time steps no row of
-/// the table measured. Measured: FIRE with safety 0.8 (each stable alone) stalled every
-/// relaxation of the scene of `tests/tests/accuracy.rs` at a residual ratio of 0.4 after
-/// 400 000 steps. At most one knob of a group is moved.
+/// the table measured. Measured before FIRE's step was capped at
+/// [`cosdem_worker::spec::FIRE_CEILING`] of the critical step: FIRE with safety 0.8 (each
+/// stable alone) stalled every relaxation of the scene of `tests/tests/accuracy.rs` at a
+/// residual ratio of 0.4 after 400 000 steps. At most one knob of a group is moved.
 pub const EXCLUSIVE: &[&[&str]] =
     &[&["relaxation.safety", "relaxation.driver", "relaxation.density_scale"]];
 
@@ -990,11 +998,11 @@ mod tests {
     #[test]
     fn measured_trade_reads() {
         let t = Trade::measured().unwrap();
-        // 17 one-knob rows and the accuracy-0.05 combination (not a candidate).
-        assert_eq!(t.settings.len(), 18);
+        // 16 one-knob rows and the accuracy-0.05 combination (not a candidate).
+        assert_eq!(t.settings.len(), 17);
         let e = t.default_error();
-        assert_eq!(e.peak, Some(1.352609e-3));
-        assert_eq!(e.stiffness, Some(2.350590e-3));
+        assert_eq!(e.peak, Some(1.352761e-3));
+        assert_eq!(e.stiffness, Some(2.361133e-3));
         assert_eq!(e.residual, None);
         // Mass scaling changed no value: no shift.
         let scaled = t.settings.iter().find(|r| r.knob == "relaxation.density_scale").unwrap();
@@ -1003,8 +1011,9 @@ mod tests {
 
     /// 5 % on the committed table: every knob that saves DEM steps within the budget is
     /// moved; the prediction is the default's error plus the sum of the shifts (checked by
-    /// hand here), within half the target; safety 0.95 (failed), mass scaling (no saving)
-    /// and the assembly size are not candidates; the tuned job has no `accuracy` left.
+    /// hand here), within half the target; safety 0.95 (failed; the default is 0.8), mass
+    /// scaling (no saving) and the assembly size are not candidates; the tuned job has no
+    /// `accuracy` left.
     #[test]
     fn five_percent_picks_the_cheap_settings_and_says_why() {
         let job = quick(Some(0.05));
@@ -1015,11 +1024,11 @@ mod tests {
         let picked = |k: &str| r.knobs.iter().find(|c| c.knob == k).unwrap().row.clone();
         assert_eq!(picked("load_step").as_deref(), Some("load_step=x4"));
         assert_eq!(picked("relaxation.tolerance").as_deref(), Some("relaxation.tolerance=1e-3"));
-        // FIRE saves more DEM steps than safety 0.8, and the two are not moved together.
+        // FIRE saves 20 % of the DEM steps; the only larger safety (0.95) failed.
         assert_eq!(picked("relaxation.driver").as_deref(), Some("relaxation.driver=fire"));
         assert_eq!(picked("relaxation.safety"), None);
         let safety = r.knobs.iter().find(|c| c.knob == "relaxation.safety").unwrap();
-        assert!(safety.why.contains("relaxation.driver was moved"), "{}", safety.why);
+        assert!(safety.why.contains("no measured setting is a candidate"), "{}", safety.why);
         assert_eq!(picked("relaxation.density_scale"), None);
         assert_eq!(picked("tangent"), None);
         let mut sum = r.default_error.peak.unwrap();
@@ -1034,7 +1043,7 @@ mod tests {
         assert!(r.not_candidates.iter().any(|n| n.starts_with("relaxation.density_scale=16")));
         let a = assembly(&plan.job);
         assert_eq!(a.relaxation.tolerance, 1e-3);
-        assert_eq!(a.relaxation.safety, 0.5);
+        assert_eq!(a.relaxation.safety, 0.8);
         assert_eq!(a.relaxation.driver, Driver::fire());
         assert_eq!(plan.job.loading.increment, Some(0.008));
         // The size is the user's: unchanged.
@@ -1107,11 +1116,11 @@ mod tests {
         assert_eq!(plan.job, crate::tradeoff::reference(&plain).job);
     }
 
-    /// A random packing is planned from the random table (the biaxial sweep): its default is
-    /// 2.1 % (F_u) / 2.8 % (E) from the tight reference, the load step's half, so a 5 %
-    /// target (budget 2.5 %) moves nothing and says so, while a 10 % target (budget 5 %)
-    /// moves the relaxation knobs that cost the least accuracy and never the load step
-    /// (4.6-13 % there).
+    /// A random packing is planned from the random table (the biaxial sweep to 1 %): its
+    /// default is 2.1 % (F_u) / 2.9 % (E) from the tight reference, the load step's half, so
+    /// a 5 % target (budget 2.5 %) moves nothing and says so, while a 10 % target (budget
+    /// 5 %) moves the relaxation tolerance (0.54 of the default's DEM steps) and never the
+    /// load step (4.8-13 % there).
     #[test]
     fn a_random_packing_is_planned_from_the_random_table() {
         let tight = tune(&random_quick(0.05)).unwrap().unwrap();
@@ -1128,7 +1137,7 @@ mod tests {
         assert!(!rows.contains(&"relaxation.safety=0.95".to_string()), "{rows:?}");
         assert!(loose.report.not_candidates.iter().any(|n| n.contains("largest safety")));
         assert!(loose.report.predicted.worst() <= 0.05);
-        assert!(loose.report.predicted_dem_steps_ratio < 0.5);
+        assert!(loose.report.predicted_dem_steps_ratio < 0.6);
     }
 
     /// The size law: the predicted size error of a matching fit is reported (and warned

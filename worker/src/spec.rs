@@ -14,7 +14,7 @@
 //!   "density": 2650.0,
 //!   "boundary": {"kind": "penalty", "eps_f": 6.7e6, "eps_c": 1000.0},
 //!   "relaxation": {"driver": {"kind": "cundall", "alpha": 0.7}, "criterion": "unbalanced_force",
-//!                  "tolerance": 1e-4, "max_steps": 400000, "check_every": 10, "safety": 0.5,
+//!                  "tolerance": 1e-4, "max_steps": 400000, "check_every": 10, "safety": 0.8,
 //!                  "density_scale": 1.0, "skin": 0.5},
 //!   "tangent": {"kind": "paper"},
 //!   "warm_start": false
@@ -215,9 +215,11 @@ pub struct RelaxationSpec {
     pub max_steps: u64,
     /// Steps between two evaluations of the criterion (default 10).
     pub check_every: u32,
-    /// Fraction of the critical step `2 / omega_max` used (default 0.5). `omega_max` is a
-    /// Gershgorin bound that already includes six contacts per disc, so 0.5 of it is about
-    /// 0.15 of the single-spring step `2 sqrt(m/k)`.
+    /// Fraction of the critical step `2 / omega_max` used (default 0.8, YADE's
+    /// `GlobalStiffnessTimeStepper` default). `omega_max` is a Gershgorin bound that already
+    /// includes six contacts per disc, so 0.8 of it is about 0.24 of the single-spring step
+    /// `2 sqrt(m/k)`. Measured (`docs/tradeoff-*.md`): 0.8 moves no error column against
+    /// 0.5 on any committed table and saves a third of the DEM steps; 0.95 failed on scene A.
     pub safety: f64,
     /// Density (mass) scaling factor >= 1 used for the relaxation only (default 1). The
     /// equilibrium reached does not depend on the masses; scaling them makes the step larger
@@ -245,7 +247,7 @@ impl Default for RelaxationSpec {
             tolerance: 1e-4,
             max_steps: 400_000,
             check_every: 10,
-            safety: 0.5,
+            safety: 0.8,
             density_scale: 1.0,
             skin: 0.5,
             skip_below: 0.0,
@@ -281,8 +283,9 @@ pub enum Driver {
         /// Downhill steps before the step may grow (default 5).
         #[serde(default = "defaults::n_min")]
         n_min: u32,
-        /// Largest step as a multiple of the base step (default 1.8, since the base step is
-        /// 0.5 of the critical step bound).
+        /// Largest step as a multiple of the base step (default 1.8), never above
+        /// [`FIRE_CEILING`] of the critical step: at the default safety 0.8 the step grows to
+        /// 0.9 of the critical step (1.125 base steps), at safety 0.5 to 0.9 (1.8).
         #[serde(default = "defaults::dt_max")]
         dt_max: f64,
     },
@@ -382,6 +385,13 @@ pub enum TangentKind {
         strain: f64,
     },
 }
+
+/// FIRE's largest step as a fraction of the critical step `2 / omega_max`, whatever its
+/// `dt_max` and the safety factor: a step above the critical one makes the stiffest
+/// oscillator grow (FIRE at safety 0.8 with the uncapped 1.8 base steps, 1.44 critical
+/// steps, stalled every relaxation of `tests/tests/accuracy.rs`'s scene at a residual ratio
+/// of 0.4). 0.9 is where the default 1.8 base steps of safety 0.5 always ended.
+pub const FIRE_CEILING: f64 = 0.9;
 
 /// The range of the [`TangentKind::Secant`] scale: never stiffer than the contact tangent,
 /// never softer than a twentieth of it (a near-zero secant would hand Newton a singular
@@ -550,11 +560,11 @@ impl AssemblySpec {
                 if !(*f_alpha > 0.0 && *f_alpha <= 1.0) {
                     return Err(invalid("relaxation.driver.f_alpha", f_alpha, "in (0, 1]"));
                 }
-                if !(*dt_max >= 1.0 && *dt_max <= 2.0 / r.safety) {
+                if !(*dt_max >= 1.0 && dt_max.is_finite()) {
                     return Err(invalid(
                         "relaxation.driver.dt_max",
                         dt_max,
-                        "must be in [1, 2/safety] (multiple of the base step, below the critical step)",
+                        "must be a finite multiple >= 1 of the base step",
                     ));
                 }
             }

@@ -97,7 +97,7 @@ fn bad_bytes_and_unknown_fields() {
       "density": 2650.0,
       "boundary": {"kind": "penalty", "eps_f": 6.7e6, "eps_c": 1000.0},
       "relaxation": {"driver": {"kind": "cundall", "alpha": 0.7}, "criterion": "unbalanced_force",
-                     "tolerance": 1e-4, "max_steps": 400000, "check_every": 10, "safety": 0.5,
+                     "tolerance": 1e-4, "max_steps": 400000, "check_every": 10, "safety": 0.8,
                      "density_scale": 1.0, "skin": 0.5},
       "tangent": {"kind": "paper"},
       "warm_start": false

@@ -28,6 +28,10 @@ fn step_cap_is_reported() {
 fn sliding_is_reported_and_softens_the_sliding_aware_tangent() {
     let target = grad([[-1e-3, 3e-3], [3e-3, -1e-3]]);
     let mut spec = hex_spec(0.1, penalty());
+    // The state this test describes is the relaxation path at time-step safety 0.5 (the
+    // default when it was written). Which contacts end sliding is path dependent: at the
+    // default 0.8 the same relaxation ends with none sliding.
+    spec.relaxation.safety = 0.5;
     let mut a = Assembly::new(&spec).unwrap();
     a.solve(&iso(-1e-3)).unwrap();
     a.commit();

@@ -8,6 +8,18 @@ use crate::integrate::{self, RelaxReport};
 use crate::spec::{BoundarySpec, RelaxationSpec, TangentKind};
 use cosdem_common::voigt::{KX, KY, N, XX, XY, YX, YY};
 use cosdem_common::{MacroDeformation, MicroDiagnostics, MicroResponse};
+
+/// How many times a relaxation that blows up (non-finite state) is redone from the same
+/// start at half the previous time step before the error is returned. The critical step is
+/// `2 / omega_max` for undamped leapfrog, but Cundall's local damping multiplies the force by
+/// `1 + alpha` while a dof decelerates, which lowers the stable step to `2 / (omega_max
+/// sqrt(1 + alpha))`: 0.77 of it at the default `alpha = 0.7`. The `omega_max` bound counts
+/// six contacts per disc and is loose for contact-dominated assemblies (safety 0.8 was
+/// stable on every committed table), but tight where a penalty spring dominates
+/// (`eps_f = 1e10` diverged at safety 0.8, `worker/tests/extremes.rs`). The retry is
+/// deterministic (same start, same halving), so the answer still depends only on the
+/// committed state and the target.
+pub const DIVERGENCE_HALVINGS: u32 = 3;
 use std::time::Instant;
 
 impl Assembly {
@@ -123,7 +135,9 @@ impl Assembly {
         self.relax_capped(st, target, tol, u64::MAX)
     }
 
-    /// [`Assembly::relax_to`] with at most `max_steps` steps (and never more than the spec's).
+    /// [`Assembly::relax_to`] with at most `max_steps` steps (and never more than the spec's)
+    /// per attempt; a relaxation that diverges is redone at half the step (see
+    /// [`DIVERGENCE_HALVINGS`]).
     fn relax_capped(
         &mut self,
         mut st: State,
@@ -144,10 +158,36 @@ impl Assembly {
         } else {
             &self.spec.relaxation
         };
-        let rep =
-            integrate::relax(&sys, &mut st.dynamics, &mut st.pairs, &mut work, spec, self.dt, tol);
+        // A blow-up is redone from the same start at half the step, at most
+        // `DIVERGENCE_HALVINGS` times; the steps of every attempt count in the report.
+        let start = (st.dynamics.clone(), st.pairs.clone());
+        let (mut dt, mut spent) = (self.dt, 0u64);
+        let mut halvings = 0;
+        let rep = loop {
+            match integrate::relax(&sys, &mut st.dynamics, &mut st.pairs, &mut work, spec, dt, tol)
+            {
+                Err(Error::Diverged { steps }) if halvings < DIVERGENCE_HALVINGS => {
+                    tracing::warn!(
+                        steps,
+                        dt,
+                        "relaxation diverged: redone at half the time step (relaxation.safety \
+                         {} is above the damped stability limit of this assembly)",
+                        spec.safety
+                    );
+                    spent += steps;
+                    dt *= 0.5;
+                    halvings += 1;
+                    (st.dynamics, st.pairs) = (start.0.clone(), start.1.clone());
+                }
+                other => break other,
+            }
+        };
         self.work = work;
-        Ok((st, rep?))
+        let rep = rep.map_err(|e| match e {
+            Error::Diverged { steps } => Error::Diverged { steps: spent + steps },
+            e => e,
+        })?;
+        Ok((st, RelaxReport { steps: spent + rep.steps, ..rep }))
     }
 
     /// Runs exactly `steps` leapfrog steps towards `target` (no convergence test): the

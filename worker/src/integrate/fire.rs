@@ -19,14 +19,15 @@ pub struct Fire {
 }
 
 impl Fire {
-    /// New FIRE state with base step `dt`.
-    pub fn new(driver: &Driver, dt: f64) -> Self {
+    /// New FIRE state with base step `dt`, growing to `dt_max` base steps but never above
+    /// `ceiling` (s).
+    pub fn new(driver: &Driver, dt: f64, ceiling: f64) -> Self {
         let Driver::Fire { alpha_start, f_inc, f_dec, f_alpha, n_min, dt_max } = *driver else {
             unreachable!("Fire::new with a non-FIRE driver")
         };
         Self {
             dt,
-            dt_max: dt * dt_max,
+            dt_max: (dt * dt_max).min(ceiling),
             alpha: alpha_start,
             alpha_start,
             f_inc,

@@ -230,7 +230,10 @@ pub fn relax(
         }
     };
     let mut fire = match spec.driver {
-        Driver::Fire { .. } => Some(fire::Fire::new(&spec.driver, dt)),
+        // `dt` is `safety` critical steps.
+        Driver::Fire { .. } => {
+            Some(fire::Fire::new(&spec.driver, dt, crate::spec::FIRE_CEILING * dt / spec.safety))
+        }
         Driver::Cundall { .. } => None,
     };
     let alpha = match spec.driver {
