@@ -120,8 +120,8 @@ pub const KNOBS: [&str; 9] = [
 ];
 
 /// Knobs that are never moved together: each group's knobs all set the relaxation's time
-/// step (safety scales it, FIRE grows it up to 1.8 times the base step that safety sets, mass
-/// scaling lengthens it), so moved together their effects multiply into time steps no row of
+/// step (safety scales it, FIRE grows it from the base step that safety sets, mass scaling
+/// lengthens it), so moved together their effects multiply into time steps no row of
 /// the table measured. Measured before FIRE's step was capped at
 /// [`cosdem_worker::spec::FIRE_CEILING`] of the critical step: FIRE with safety 0.8 (each
 /// stable alone) stalled every relaxation of the scene of `tests/tests/accuracy.rs` at a

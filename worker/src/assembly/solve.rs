@@ -8,6 +8,7 @@ use crate::integrate::{self, RelaxReport};
 use crate::spec::{BoundarySpec, RelaxationSpec, TangentKind};
 use cosdem_common::voigt::{KX, KY, N, XX, XY, YX, YY};
 use cosdem_common::{MacroDeformation, MicroDiagnostics, MicroResponse};
+use std::time::Instant;
 
 /// How many times a relaxation that blows up (non-finite state) is redone from the same
 /// start at half the previous time step before the error is returned. The critical step is
@@ -20,7 +21,6 @@ use cosdem_common::{MacroDeformation, MicroDiagnostics, MicroResponse};
 /// deterministic (same start, same halving), so the answer still depends only on the
 /// committed state and the target.
 pub const DIVERGENCE_HALVINGS: u32 = 3;
-use std::time::Instant;
 
 impl Assembly {
     /// Trial solve: the shortcut answer when `relaxation.skip_below` or

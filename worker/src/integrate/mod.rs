@@ -230,7 +230,7 @@ pub fn relax(
         }
     };
     let mut fire = match spec.driver {
-        // `dt` is `safety` critical steps.
+        // `dt` is `safety` critical steps (a divergence retry halves it, and the ceiling).
         Driver::Fire { .. } => {
             Some(fire::Fire::new(&spec.driver, dt, crate::spec::FIRE_CEILING * dt / spec.safety))
         }
