@@ -59,6 +59,21 @@ impl MacroDeformation {
         Self::from_gradient(g, w, [e[KX], e[KY]])
     }
 
+    /// The deformation a fraction `t` of the way from `self` to `to`: `F`, `w` and `kappa`
+    /// each linear in `t` (the straight path of a load step in the macro dofs, which are
+    /// linear in all three). `t = 0` is `self`, `t = 1` is `to` exactly.
+    pub fn interpolate(&self, to: &Self, t: f64) -> Self {
+        if t == 1.0 {
+            return *to;
+        }
+        let l = |a: f64, b: f64| (b - a).mul_add(t, a);
+        Self {
+            f: std::array::from_fn(|a| std::array::from_fn(|b| l(self.f[a][b], to.f[a][b]))),
+            w: l(self.w, to.w),
+            kappa: std::array::from_fn(|a| l(self.kappa[a], to.kappa[a])),
+        }
+    }
+
     /// Displacement gradient `du_a/dx_b = F_ab - delta_ab`.
     pub fn gradient(&self) -> [[f64; 2]; 2] {
         [[self.f[0][0] - 1.0, self.f[0][1]], [self.f[1][0], self.f[1][1] - 1.0]]
@@ -120,6 +135,20 @@ mod tests {
         assert!(err.contains("k_y"), "{err}");
         let m = MacroDeformation::from_gradient([[-1.0, 0.0], [0.0, 0.0]], 0.0, [0.0; 2]);
         assert!(matches!(m.validate(), Err(KinematicsError::NotInvertible { .. })));
+    }
+
+    #[test]
+    fn interpolate_ends_exactly_and_is_linear_in_the_strain() {
+        let a = MacroDeformation::from_gradient([[1e-3, 2e-4], [-3e-4, -2e-3]], 1e-4, [0.5, -0.2]);
+        let b = MacroDeformation::from_gradient([[3e-3, -1e-4], [5e-4, -6e-3]], -2e-4, [0.1, 0.3]);
+        assert_eq!(a.interpolate(&b, 0.0), a);
+        assert_eq!(a.interpolate(&b, 1.0), b);
+        // The strain is linear in F and w, so the midpoint's strain is the mean strain, to a
+        // few roundings of the largest number involved: F_xx, F_yy near 1 (ulp 2.2e-16).
+        let (ea, eb, em) = (a.strain(), b.strain(), a.interpolate(&b, 0.5).strain());
+        for k in 0..N {
+            assert!((em[k] - 0.5 * (ea[k] + eb[k])).abs() <= 4.0 * f64::EPSILON, "component {k}");
+        }
     }
 
     proptest! {

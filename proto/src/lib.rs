@@ -18,8 +18,10 @@ pub mod to_proto;
 pub use from_proto::ConvertError;
 
 /// The protocol version a master and a worker must agree on at handshake. 2: a SolveBatch
-/// may carry the commit of the previous step (a worker of protocol 1 would ignore it).
-pub const PROTOCOL_VERSION: u32 = 2;
+/// may carry the commit of the previous step (a worker of protocol 1 would ignore it). 3: the
+/// assembly spec has `relaxation.substep` (a worker of protocol 2 refuses the spec with an
+/// unknown field; the handshake says so first, naming both versions).
+pub const PROTOCOL_VERSION: u32 = 3;
 
 /// Default limit on one gRPC message, both directions (256 MiB): large assemblies'
 /// exported states and snapshots must pass.

@@ -5,7 +5,7 @@ use crate::contact::rolling;
 use crate::error::{Error, Result};
 use crate::homogenize::{Homogenized, homogenize};
 use crate::integrate::{self, RelaxReport};
-use crate::spec::{BoundarySpec, RelaxationSpec, TangentKind};
+use crate::spec::{BoundarySpec, MAX_SUBSTEPS, RelaxationSpec, TangentKind};
 use cosdem_common::voigt::{KX, KY, N, XX, XY, YX, YY};
 use cosdem_common::{MacroDeformation, MicroDiagnostics, MicroResponse};
 use std::time::Instant;
@@ -125,14 +125,43 @@ impl Assembly {
         homogenize(&self.law, &d.x, &d.y, &self.refc.r, &st.pairs, st.target.det() * self.refc.area)
     }
 
-    /// Jumps `st` affinely to `target` and relaxes it with tolerance `tol`.
+    /// Jumps `st` affinely to `target` and relaxes it with tolerance `tol`; with
+    /// `relaxation.substep` set, in [`Assembly::substeps`] equal jumps along the straight path,
+    /// each relaxed in turn (the steps of all of them are counted; the answer counts as
+    /// converged only if every one converged).
     pub fn relax_to(
         &mut self,
         st: State,
         target: &MacroDeformation,
         tol: f64,
     ) -> Result<(State, RelaxReport)> {
-        self.relax_capped(st, target, tol, u64::MAX)
+        let n = self.substeps(&st.target, target);
+        let from = st.target;
+        let (mut st, mut steps, mut all_converged) = (st, 0u64, true);
+        for i in 1..n {
+            let t = from.interpolate(target, i as f64 / n as f64);
+            let (s, rep) = self.relax_capped(st, &t, tol, u64::MAX)?;
+            steps = steps.saturating_add(rep.steps);
+            all_converged &= rep.converged;
+            st = s;
+        }
+        let (st, rep) = self.relax_capped(st, target, tol, u64::MAX)?;
+        let converged = rep.converged && all_converged;
+        Ok((st, RelaxReport { steps: steps.saturating_add(rep.steps), converged, ..rep }))
+    }
+
+    /// Number of affine jumps from `from` to `to`: `ceil(size / substep)` in the measure of
+    /// [`Assembly::increment_size`], between 1 and [`MAX_SUBSTEPS`]; 1 when
+    /// `relaxation.substep` is 0 (off).
+    pub fn substeps(&self, from: &MacroDeformation, to: &MacroDeformation) -> u64 {
+        let h = self.spec.relaxation.substep;
+        if h <= 0.0 {
+            return 1;
+        }
+        // The ratio is finite and >= 0 (validated h > 0, finite deformations); a tiny margin
+        // keeps an increment of exactly k substeps at k jumps despite rounding.
+        let n = (self.increment_size(from, to) / h * (1.0 - 1e-12)).ceil();
+        if n.is_nan() { 1 } else { (n as u64).clamp(1, MAX_SUBSTEPS) }
     }
 
     /// [`Assembly::relax_to`] with at most `max_steps` steps (and never more than the spec's)
