@@ -321,6 +321,9 @@ pub struct NewtonSection {
     /// Relative force residual at which a step that ran out of iterations is accepted as
     /// "tolerated" instead of cut (0 = never; see `SolverSettings::tolerated_residual`).
     pub tolerated_residual: f64,
+    /// Gauss-point secant updates of the iteration matrix within a step (see
+    /// `SolverSettings::secant_updates`).
+    pub secant_updates: bool,
 }
 
 impl Default for NewtonSection {
@@ -333,6 +336,7 @@ impl Default for NewtonSection {
             line_search: s.line_search,
             min_increment_fraction: s.min_increment_fraction,
             tolerated_residual: s.tolerated_residual,
+            secant_updates: s.secant_updates,
         }
     }
 }
@@ -711,6 +715,7 @@ impl Job {
             line_search: n.line_search,
             min_increment_fraction: n.min_increment_fraction,
             tolerated_residual: n.tolerated_residual,
+            secant_updates: n.secant_updates,
             ..SolverSettings::default()
         })
     }

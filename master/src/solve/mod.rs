@@ -5,6 +5,7 @@ mod linear;
 mod loading;
 mod newton;
 mod observer;
+pub mod secant;
 
 pub use linear::LinearSolver;
 pub use loading::{

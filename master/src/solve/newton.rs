@@ -9,6 +9,7 @@
 use super::linear::LinearSolver;
 use super::loading::{LoadVectors, Loading};
 use super::observer::{GaussPointState, SolutionView, StepControl, StepObserver, StepReport};
+use super::secant::PointSecant;
 use crate::assembly::{Assembled, CosseratOperator, DofMap, Field, GaussData, Pattern};
 use crate::element::{ElementKind, QuadratureRule};
 use crate::error::{Error, Result};
@@ -70,6 +71,14 @@ pub struct SolverSettings {
     pub tolerated_residual: f64,
     /// Growth factor of the increment after an easy step (capped at the nominal increment).
     pub growth: f64,
+    /// Gauss-point secant updates of the iteration matrix within a step
+    /// ([`super::secant`]): every point's matrix, from the material's tangent at the step's
+    /// start, is softened along each move of the point to the stiffness that move measured
+    /// (a rank-one update), so that a soft mode converges as the secant method instead of a
+    /// fixed-point iteration with the elastic slope. Off: the material's tangent of every
+    /// answer.
+    #[serde(default)]
+    pub secant_updates: bool,
 }
 
 impl Default for SolverSettings {
@@ -88,6 +97,7 @@ impl Default for SolverSettings {
             easy_iterations: 4,
             growth: 2.0,
             tolerated_residual: 0.0,
+            secant_updates: false,
         }
     }
 }
@@ -553,6 +563,7 @@ impl Solver {
         iteration: &mut u32,
         target: f64,
     ) -> Result<Attempt> {
+        // The secant update keeps a symmetric tangent symmetric (`(B de)(B de)^T`).
         let symmetric = material.is_symmetric();
         let f_ext = self.loads.f_ext(target);
         let du_c: Vec<f64> = self
@@ -578,6 +589,15 @@ impl Solver {
             },
         };
         let asm = self.assemble(&responses, Some(&du_c));
+        // Secant updates start from the material's tangent at the step's start.
+        let mut secants: Option<Vec<PointSecant>> = self.settings.secant_updates.then(|| {
+            let inputs = self.operator.kinematics(&self.model.mesh, &self.gauss, &self.u);
+            inputs
+                .iter()
+                .zip(&responses)
+                .map(|(i, r)| PointSecant::new(i.deformation.strain(), r.stress, r.tangent))
+                .collect()
+        });
         self.committed = Some(responses);
         let (r0, _) = self.residual(&asm.f_int, &f_ext);
         let mut rhs: Vec<f64> = r0.iter().zip(&asm.k_fc_du).map(|(r, k)| -(r + k)).collect();
@@ -659,6 +679,24 @@ impl Solver {
                     });
                 }
                 break;
+            }
+            // An iteration that did not contract ends the secant updates of this attempt: the
+            // rest of it iterates with the answers' own tangents (as without the option; the
+            // matrix in `self.values` is this iteration's answers' own, assembled above).
+            let n = residuals.len();
+            if n >= 2 && rel > super::secant::RESTART_CONTRACTION * residuals[n - 2] {
+                secants = None;
+            }
+            if let Some(secants) = &mut secants {
+                // The iteration matrix from the points' updated tangents (the residual above
+                // is the answers' own; only the matrix changes).
+                let inputs = self.operator.kinematics(&self.model.mesh, &self.gauss, &u);
+                let mut updated = responses.clone();
+                for ((p, i), r) in secants.iter_mut().zip(&inputs).zip(&mut updated) {
+                    p.advance(i.deformation.strain(), r.stress);
+                    r.tangent = p.matrix;
+                }
+                self.assemble(&updated, None);
             }
             let mut rhs: Vec<f64> = r.iter().map(|x| -x).collect();
             if let Err(s) = self.linear.solve(&self.values, &mut rhs, symmetric) {
