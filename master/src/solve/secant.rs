@@ -133,7 +133,8 @@ pub fn directional_secant(
 /// stall). Past a peak a relaxed assembly's answers scatter, and a matrix softened by that
 /// scatter lets corrections drift: measured on the biaxial example without this safeguard,
 /// the residual rose from 0.6 % to 1.4 % over twenty iterations, and the whole example took
-/// 829 s with 71 tolerated steps, against 91 s and 3 with it (the default: 75 s, 7). The
+/// 829 s with 71 tolerated steps (another run shared the machine), against 62.5 s and 3 with
+/// it on a quiet machine (the default: 67.5 s, 7). The
 /// textbook restart (updates start again from the answers' tangents) was tried on the smooth
 /// softening panel of `master/tests/newton.rs`: near its peak it took 222 iterations, the
 /// same as this rule, against 102 without updates.
