@@ -567,16 +567,9 @@ pub fn apply_setting(job: &mut Job, knob: &str, setting: &str) -> Result<(), Tab
         }
         return Ok(());
     }
-    match (knob, setting) {
-        ("newton.secant_updates", "true") => {
-            job.newton.secant_updates = true;
-            return Ok(());
-        }
-        ("newton.secant_updates", "false") => {
-            job.newton.secant_updates = false;
-            return Ok(());
-        }
-        _ => {}
+    if let ("newton.secant_updates", "true" | "false") = (knob, setting) {
+        job.newton.secant_updates = setting == "true";
+        return Ok(());
     }
     let a = assembly_mut(job).ok_or_else(unknown)?;
     match (knob, setting) {

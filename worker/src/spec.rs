@@ -245,7 +245,7 @@ pub struct RelaxationSpec {
     /// strain-rate-driven DEM test does, instead of in one jump. The contact histories are
     /// path dependent, so past a peak the answer depends on the size of the jumps: on the
     /// biaxial example's specimen, jumps of 1e-3 strain miss the second softening that
-    /// jumps of 5e-4 and below follow (F_res 19.6e3 against 15.8-16.9e3 N/m, `docs/`).
+    /// jumps of 5e-4 and below follow (F_res 19.6e3 against 15.8-16.9e3 N, docs/substep-biaxial.md).
     pub substep: f64,
 }
 

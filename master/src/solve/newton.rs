@@ -13,7 +13,7 @@ use super::secant::PointSecant;
 use crate::assembly::{Assembled, CosseratOperator, DofMap, Field, GaussData, Pattern};
 use crate::element::{ElementKind, QuadratureRule};
 use crate::error::{Error, Result};
-use crate::material::{Material, MaterialError, TrialId};
+use crate::material::{Material, MaterialError, MaterialInput, TrialId};
 use crate::mesh::Mesh;
 use cosdem_common::{GaussPointId, MicroResponse};
 use std::collections::BTreeMap;
@@ -213,6 +213,9 @@ impl Failure {
         }
     }
 }
+
+/// One evaluation of the material: the answers and the kinematics they answer.
+type Evaluation = (Vec<MicroResponse>, Vec<MaterialInput>);
 
 enum Attempt {
     Converged { iterations: u32, residuals: Vec<f64>, halvings: u32, tolerated: bool },
@@ -501,13 +504,14 @@ impl Solver {
         Ok(summary)
     }
 
-    /// Evaluates the material at `u`; material failures become [`Failure`]s.
+    /// Evaluates the material at `u`: the answers and the kinematics they answer; material
+    /// failures become [`Failure`]s.
     fn evaluate(
         &self,
         material: &mut dyn Material,
         trial: TrialId,
         u: &[f64],
-    ) -> Result<std::result::Result<Vec<MicroResponse>, Failure>> {
+    ) -> Result<std::result::Result<Evaluation, Failure>> {
         let inputs = self.operator.kinematics(&self.model.mesh, &self.gauss, u);
         match material.evaluate(trial, &inputs) {
             Ok(r) if r.len() != inputs.len() => {
@@ -522,7 +526,7 @@ impl Solver {
                     .filter(|(r, _)| !r.is_finite())
                     .map(|(_, i)| (i.gauss_point, "non-finite stress or tangent".to_string()))
                     .collect();
-                if bad.is_empty() { Ok(Ok(r)) } else { Ok(Err(Failure::NotFinite(bad))) }
+                if bad.is_empty() { Ok(Ok((r, inputs))) } else { Ok(Err(Failure::NotFinite(bad))) }
             }
             Err(MaterialError::GaussPoints(p)) => Ok(Err(Failure::Material(p))),
             Err(e @ MaterialError::Unavailable(_)) => Err(e.into()),
@@ -584,18 +588,18 @@ impl Solver {
         let responses = match self.committed.take() {
             Some(r) => r,
             None => match self.evaluate(material, next_trial(iteration), &self.u)? {
-                Ok(r) => r,
+                Ok((r, _)) => r,
                 Err(f) => return Ok(Attempt::Failed(f)),
             },
         };
         let asm = self.assemble(&responses, Some(&du_c));
-        // Secant updates start from the material's tangent at the step's start.
+        // Secant updates start from the material's tangent at the step's start (the converged
+        // strains are the Gauss-point states').
         let mut secants: Option<Vec<PointSecant>> = self.settings.secant_updates.then(|| {
-            let inputs = self.operator.kinematics(&self.model.mesh, &self.gauss, &self.u);
-            inputs
+            self.states
                 .iter()
                 .zip(&responses)
-                .map(|(i, r)| PointSecant::new(i.deformation.strain(), r.stress, r.tangent))
+                .map(|(g, r)| PointSecant::new(g.strain, r.stress, r.tangent))
                 .collect()
         });
         self.committed = Some(responses);
@@ -622,11 +626,12 @@ impl Solver {
             let span = tracing::info_span!("newton", iteration = k);
             let _enter = span.enter();
             let mut alpha = 1.0;
-            let (responses, asm, r, scale) = loop {
-                let responses = match self.evaluate(material, next_trial(iteration), &u)? {
-                    Ok(r) => r,
-                    Err(f) => return Ok(Attempt::Failed(f)),
-                };
+            let (responses, inputs, asm, r, scale) = loop {
+                let (responses, inputs) =
+                    match self.evaluate(material, next_trial(iteration), &u)? {
+                        Ok(r) => r,
+                        Err(f) => return Ok(Attempt::Failed(f)),
+                    };
                 let asm = self.assemble(&responses, None);
                 let (r, scale) = self.residual(&asm.f_int, &f_ext);
                 let grows = previous.as_ref().is_some_and(|(_, rp)| norm(&r) > *rp);
@@ -634,7 +639,7 @@ impl Solver {
                     && grows
                     && alpha > 0.5f64.powi(self.settings.max_line_search as i32);
                 if !can_cut {
-                    break (responses, asm, r, scale);
+                    break (responses, inputs, asm, r, scale);
                 }
                 alpha *= 0.5;
                 halvings += 1;
@@ -658,7 +663,7 @@ impl Solver {
             let by_displacement =
                 k > 1 && du_norm <= self.settings.displacement_tolerance * step_norm;
             if by_force || by_displacement {
-                self.accept(u, &responses, &asm.f_int, &f_ext);
+                self.accept(u, &inputs, &responses, &asm.f_int, &f_ext);
                 self.committed = Some(responses);
                 return Ok(Attempt::Converged {
                     iterations: k,
@@ -669,7 +674,7 @@ impl Solver {
             }
             if k > self.settings.max_iterations {
                 if rel <= self.settings.tolerated_residual {
-                    self.accept(u, &responses, &asm.f_int, &f_ext);
+                    self.accept(u, &inputs, &responses, &asm.f_int, &f_ext);
                     self.committed = Some(responses);
                     return Ok(Attempt::Converged {
                         iterations: k,
@@ -690,7 +695,6 @@ impl Solver {
             if let Some(secants) = &mut secants {
                 // The iteration matrix from the points' updated tangents (the residual above
                 // is the answers' own; only the matrix changes).
-                let inputs = self.operator.kinematics(&self.model.mesh, &self.gauss, &u);
                 let mut updated = responses.clone();
                 for ((p, i), r) in secants.iter_mut().zip(&inputs).zip(&mut updated) {
                     p.advance(i.deformation.strain(), r.stress);
@@ -718,10 +722,17 @@ impl Solver {
         }
     }
 
-    /// Stores the converged state: dofs, Gauss-point states, reactions.
-    fn accept(&mut self, u: Vec<f64>, responses: &[MicroResponse], f_int: &[f64], f_ext: &[f64]) {
-        let inputs = self.operator.kinematics(&self.model.mesh, &self.gauss, &u);
-        for ((s, i), r) in self.states.iter_mut().zip(&inputs).zip(responses) {
+    /// Stores the converged state: dofs, Gauss-point states (from the kinematics `inputs` at
+    /// `u` and their answers), reactions.
+    fn accept(
+        &mut self,
+        u: Vec<f64>,
+        inputs: &[MaterialInput],
+        responses: &[MicroResponse],
+        f_int: &[f64],
+        f_ext: &[f64],
+    ) {
+        for ((s, i), r) in self.states.iter_mut().zip(inputs).zip(responses) {
             s.strain = i.deformation.strain();
             s.stress = r.stress;
             s.diagnostics = r.diagnostics.clone();
@@ -752,7 +763,7 @@ impl Solver {
         let t = std::time::Instant::now();
         let trial = TrialId { step: self.step + 1, iteration: 0 };
         let responses = match self.evaluate(material, trial, &self.u)? {
-            Ok(r) => r,
+            Ok((r, _)) => r,
             Err(f) => return Err(Error::LinearSolver(f.reason())),
         };
         let material_s = t.elapsed().as_secs_f64();

@@ -86,8 +86,8 @@ pub fn metric(c: &Tangent) -> [f64; N] {
 /// `de . C0 de` of the step's starting tangent `c0`; then `de . B de = w`, and `B` is
 /// unchanged on every direction `u` with `(B^T de) . u = 0`. Bounding against `c0`, not
 /// against the current `B`, keeps repeated updates along one direction from compounding.
-/// `scale` is the size of the step's own strain increment at this point: a change below
-/// [`MIN_RELATIVE_STEP`] of it is relaxation noise, not a slope. Returns false (and leaves `b`
+/// `step` is the step's own strain increment at this point: a change below
+/// [`MIN_RELATIVE_STEP`] of its size is relaxation noise, not a slope. Returns false (and leaves `b`
 /// alone) when the step is too small, the work along it is not positive under `b` or `c0`, or
 /// anything is not finite.
 pub fn directional_secant(
@@ -95,11 +95,12 @@ pub fn directional_secant(
     c0: &Tangent,
     de: &[f64; N],
     ds: &StressVector,
-    scale: f64,
+    step: &[f64; N],
 ) -> bool {
     let m = metric(c0);
-    let size = (0..N).map(|i| m[i] * de[i] * de[i]).sum::<f64>().sqrt();
-    if !(size.is_finite() && size > MIN_RELATIVE_STEP * scale && size > 0.0) {
+    let size_of = |v: &[f64; N]| (0..N).map(|i| m[i] * v[i] * v[i]).sum::<f64>().sqrt();
+    let size = size_of(de);
+    if !(size.is_finite() && size > MIN_RELATIVE_STEP * size_of(step) && size > 0.0) {
         return false;
     }
     let quadratic = |c: &Tangent| -> f64 {
@@ -167,9 +168,8 @@ impl PointSecant {
     pub fn advance(&mut self, strain: [f64; N], stress: StressVector) -> bool {
         let de: [f64; N] = std::array::from_fn(|i| strain[i] - self.strain[i]);
         let ds: StressVector = std::array::from_fn(|i| stress[i] - self.stress[i]);
-        let m = metric(&self.initial);
-        let scale = (0..N).map(|i| m[i] * (strain[i] - self.start[i]).powi(2)).sum::<f64>().sqrt();
-        let updated = directional_secant(&mut self.matrix, &self.initial, &de, &ds, scale);
+        let step: [f64; N] = std::array::from_fn(|i| strain[i] - self.start[i]);
+        let updated = directional_secant(&mut self.matrix, &self.initial, &de, &ds, &step);
         self.strain = strain;
         self.stress = stress;
         updated
@@ -195,6 +195,9 @@ mod tests {
         c
     }
 
+    /// A step's strain increment of 1e-3 (the noise threshold's scale in these tests).
+    const STEP: [f64; N] = [1e-3, 0.0, 0.0, 0.0, 0.0, 0.0];
+
     /// `B v` for a matrix and a vector.
     fn apply(b: &Tangent, v: &[f64; N]) -> [f64; N] {
         std::array::from_fn(|i| (0..N).map(|j| b[i][j] * v[j]).sum())
@@ -211,7 +214,7 @@ mod tests {
         let de = [1e-4, -2e-4, 3e-5, 0.0, 1e-3, 0.0];
         // A softer answer than the tangent's along de: ratio about 0.3.
         let ds = apply(&c0, &de).map(|v| 0.3 * v + 1.0);
-        assert!(directional_secant(&mut b, &c0, &de, &ds, 1e-4));
+        assert!(directional_secant(&mut b, &c0, &de, &ds, &[1e-4, 0.0, 0.0, 0.0, 0.0, 0.0]));
         // de . B de = de . ds: to rounding of the largest term (6.5e7 * 4e-8 = 2.6, a few
         // ulps relative).
         let (work, elastic) = (dot(&de, &ds), dot(&de, &apply(&b, &de)));
@@ -235,11 +238,11 @@ mod tests {
         let elastic0 = dot(&de, &apply(&c0, &de));
         // Stiffer than the tangent: nothing to soften, the ratio is capped at 1.
         let mut b = c0;
-        assert!(directional_secant(&mut b, &c0, &de, &apply(&c0, &de).map(|v| 2.0 * v), 1e-4));
+        assert!(directional_secant(&mut b, &c0, &de, &apply(&c0, &de).map(|v| 2.0 * v), &STEP));
         assert!((dot(&de, &apply(&b, &de)) - elastic0).abs() <= 1e-12 * elastic0);
         // Negative work (a softening answer or noise): MIN_RATIO of the stiffness stays.
         let mut b = c0;
-        assert!(directional_secant(&mut b, &c0, &de, &apply(&c0, &de).map(|v| -v), 1e-4));
+        assert!(directional_secant(&mut b, &c0, &de, &apply(&c0, &de).map(|v| -v), &STEP));
         let kept = dot(&de, &apply(&b, &de)) / elastic0;
         assert!((kept - MIN_RATIO).abs() <= 1e-12, "{kept}");
     }
@@ -250,22 +253,22 @@ mod tests {
         let mut b = c0;
         let de = [1e-6, 0.0, 0.0, 0.0, 0.0, 0.0];
         // 1e-6 against a step increment of 1e-3: below MIN_RELATIVE_STEP, noise.
-        assert!(!directional_secant(&mut b, &c0, &de, &[1.0; N], 1e-3));
+        assert!(!directional_secant(&mut b, &c0, &de, &[1.0; N], &STEP));
         assert!(!directional_secant(
             &mut b,
             &c0,
             &[f64::NAN, 0.0, 0.0, 0.0, 0.0, 0.0],
             &[1.0; N],
-            1e-3
+            &STEP
         ));
         assert!(!directional_secant(
             &mut b,
             &c0,
             &[1e-3, 0.0, 0.0, 0.0, 0.0, 0.0],
             &[f64::INFINITY; N],
-            1e-3
+            &STEP
         ));
-        assert!(!directional_secant(&mut b, &c0, &[0.0; N], &[1.0; N], 0.0));
+        assert!(!directional_secant(&mut b, &c0, &[0.0; N], &[1.0; N], &[0.0; N]));
         assert_eq!(b, c0);
     }
 
