@@ -355,7 +355,13 @@ pub struct OutputSection {
     pub field_plots_at: Vec<f64>,
     /// Write `checkpoint.bin` every this many steps (0: only when stopped by Ctrl-C).
     pub checkpoint_every: usize,
+    /// Upper end (m) of the linear range the stiffness E is fitted over
+    /// ([`crate::post::CurveMetrics`]); the paper's 0.01 m.
+    pub linear_range: f64,
 }
+
+/// The paper's linear range for the stiffness E: displacements up to 0.01 m.
+pub const PAPER_LINEAR_RANGE: f64 = 0.01;
 
 impl Default for OutputSection {
     fn default() -> Self {
@@ -365,6 +371,7 @@ impl Default for OutputSection {
             snapshots: Vec::new(),
             field_plots_at: Vec::new(),
             checkpoint_every: 1,
+            linear_range: PAPER_LINEAR_RANGE,
         }
     }
 }
@@ -573,6 +580,7 @@ impl Job {
                 ));
             }
         }
+        positive("output.linear_range", self.output.linear_range)?;
         for &d in &self.output.field_plots_at {
             if !(d.is_finite() && d >= 0.0) {
                 return Err(bad("output.field_plots_at", d, "must be finite and >= 0 (m)"));
@@ -789,6 +797,22 @@ mod tests {
         }
         let err = Job::from_toml(&format!("accuracy = 0.05\n{MINIMAL}"), "j").unwrap_err();
         assert!(err.to_string().contains("accuracy") && err.to_string().contains("dem"), "{err}");
+    }
+
+    /// E's linear range is the paper's 0.01 m unless the job sets its own, which reaches the
+    /// run writer; a range that is not a positive length is refused naming the key.
+    #[test]
+    fn linear_range_defaults_to_the_papers_and_is_validated() {
+        let job = Job::from_toml(MINIMAL, "j").unwrap();
+        assert_eq!(job.output.linear_range, PAPER_LINEAR_RANGE);
+        assert_eq!(crate::run::run_settings(&job).linear_range, 0.01);
+        let with = |v: &str| format!("{MINIMAL}\n[output]\nlinear_range = {v}\n");
+        let job = Job::from_toml(&with("1e-3"), "j").unwrap();
+        assert_eq!(crate::run::run_settings(&job).linear_range, 1e-3);
+        for bad in ["0.0", "-1e-3", "nan", "inf"] {
+            let err = Job::from_toml(&with(bad), "j").unwrap_err().to_string();
+            assert!(err.contains("output.linear_range"), "{bad}: {err}");
+        }
     }
 
     #[test]

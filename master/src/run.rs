@@ -71,7 +71,7 @@ pub fn run_settings(job: &Job) -> RunSettings {
         load_scale: job.load_scale(),
         vtk_every: job.output.vtk_every,
         internal_length: internal_length(job),
-        linear_range: 0.01,
+        linear_range: job.output.linear_range,
     }
 }
 
