@@ -91,6 +91,36 @@ fn step_cutting_recovers_from_injected_gauss_point_failure() {
     }
 }
 
+/// A cut increment grows back after a step that needed no cut of its own even when no step
+/// is "easy" (`easy_iterations = 0` here; past a peak the paper tangent takes 10-20
+/// iterations at every increment). The failure at strain jumps above 4e-3 cuts the single
+/// 0.02 m step to 1/8 (2.5e-3); every uncut step then tries twice the increment (5e-3), which
+/// fails and is cut back, so the steps alternate uncut / cut. Under the old rule (grow only
+/// after easy steps) no step after the first would have tried to grow: all uncut.
+#[test]
+fn a_cut_increment_grows_back_after_uncut_steps() {
+    let target = GaussPointId::new(3, 2);
+    let mut mat = FailureInjector::new(elastic(), vec![target], 4e-3);
+    let settings = SolverSettings { steps: 1, easy_iterations: 0, ..Default::default() };
+    let mut solver = Solver::new(panel(-0.02), settings).unwrap();
+    let mut log: Vec<StepReport> = Vec::new();
+    solver.run(&mut mat, &mut log).unwrap();
+    assert!((solver.load_factor() - 1.0).abs() < 1e-12);
+    assert!(log[0].cuts >= 2, "{:?}", log[0]);
+    assert!(log.iter().all(|s| s.iterations > 0), "no easy steps: {log:?}");
+    // After an uncut step the next attempt is twice as large: it either holds (a larger
+    // increment) or is cut (a reported cut).
+    for w in log.windows(2) {
+        if w[0].cuts == 0 {
+            assert!(
+                w[1].cuts >= 1 || w[1].increment > 1.5 * w[0].increment,
+                "an uncut step did not grow the next attempt: {log:?}"
+            );
+        }
+    }
+    assert!(log.iter().filter(|s| s.cuts == 0).count() >= 2, "{log:?}");
+}
+
 /// When even the minimum increment fails, the error names the Gauss point and the reason.
 #[test]
 fn below_minimum_increment_the_error_names_the_gauss_point() {
