@@ -41,6 +41,9 @@ mod tests {
     }
 }
 
+/// Relative slack of the linear range's end: a point within it counts as on the end.
+pub const RANGE_SLACK: f64 = 1e-9;
+
 /// What the paper reads off a load-displacement curve (THEORY.md section 4, scene A).
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct CurveMetrics {
@@ -72,7 +75,11 @@ impl CurveMetrics {
         let residual_load = (ipk + 1 < curve.len())
             .then(|| curve[ipk + 1..].iter().map(|p| p.1).fold(f64::INFINITY, f64::min));
         let (mut sxy, mut sxx) = (0.0, 0.0);
-        for &(d, f) in curve.iter().filter(|p| p.0 <= linear_range) {
+        // The displacements are sums of increments: the point meant to sit on the range's end
+        // can be an ulp beyond it (20 steps of 5e-5 m reach 0.0010000000000000002 m), and
+        // dropping it made two runs of the same curve fit E over different points.
+        let end = linear_range * (1.0 + RANGE_SLACK);
+        for &(d, f) in curve.iter().filter(|p| p.0 <= end) {
             sxy += d * f;
             sxx += d * d;
         }
@@ -121,6 +128,35 @@ mod curve_tests {
         assert!((m.stiffness.unwrap() - 1e6).abs() < 1e-6);
         // Half the peak (1e4 N) is reached at 0.01 m: E50 = 1e4 / 0.01 = 1e6.
         assert!((m.stiffness_50.unwrap() - 1e6).abs() < 1e-6);
+    }
+
+    /// The point on the linear range's end counts whatever the round-off of the summed
+    /// increments that reached it: 20 steps of 5e-5 m end at 0.0010000000000000002 m, 10 of
+    /// 1e-4 m at 0.001 m, and both fit E over the same points. A point clearly beyond the end
+    /// (1e-6 relative) does not count.
+    #[test]
+    fn the_linear_range_end_survives_summed_increments() {
+        let walk = |n: usize, h: f64| {
+            let mut d = 0.0;
+            (0..n)
+                .map(|_| {
+                    d += h;
+                    (d, 1e6 * d + if d > 0.00095 + 1e-12 { 1e3 } else { 0.0 })
+                })
+                .collect::<Vec<_>>()
+        };
+        let fine = walk(20, 5e-5);
+        assert!(fine.last().unwrap().0 > 1e-3, "the fine walk overshoots by an ulp");
+        let fine = CurveMetrics::from_curve(&fine, 1e-3).stiffness.unwrap();
+        let mut exact: Vec<_> = walk(20, 5e-5);
+        exact.last_mut().unwrap().0 = 1e-3;
+        let exact = CurveMetrics::from_curve(&exact, 1e-3).stiffness.unwrap();
+        assert!((fine / exact - 1.0).abs() < 1e-12, "{fine} vs {exact}");
+        // The last point carries a 1e3 N bump: dropping it would give exactly 1e6.
+        assert!(fine > 1e6 * (1.0 + 1e-3), "{fine}");
+        let beyond = [(5e-4, 500.0), (1e-3 * (1.0 + 1e-6), 5e3)];
+        let e = CurveMetrics::from_curve(&beyond, 1e-3).stiffness.unwrap();
+        assert!((e / 1e6 - 1.0).abs() < 1e-12, "{e}");
     }
 
     /// Before the peak is passed there is no residual capacity.

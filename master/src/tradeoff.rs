@@ -878,7 +878,13 @@ mod tests {
                 1,
                 false,
             ),
-            ("tradeoff-biaxial.csv", include_str!("../../docs/tradeoff-biaxial.csv"), 15, 0, true),
+            (
+                "tradeoff-biaxial-5mm.csv",
+                include_str!("../../docs/tradeoff-biaxial-5mm.csv"),
+                15,
+                0,
+                true,
+            ),
             (
                 "tradeoff-biaxial-1mm.csv",
                 include_str!("../../docs/tradeoff-biaxial-1mm.csv"),

@@ -4,7 +4,7 @@
 //! sticking contact as elastic. Once contacts slide the relaxed response is much softer than
 //! that tangent, and Newton with it contracts only by about `1 - K_true / K_paper` per
 //! iteration: on the biaxial example 8-14 iterations per step before the peak and up to 21,
-//! the cap, past it (docs/tradeoff-biaxial.md). The relaxation answers are what they are; the
+//! the cap, past it (docs/tradeoff-biaxial-5mm.md). The relaxation answers are what they are; the
 //! tangent is only the iteration matrix, so it may be improved from what the iterations
 //! already measured. Measured value (docs/substep-biaxial.md): before the peak 3-4 iterations
 //! per step and half the DEM steps; past the peak none (the updates end at the first stall).
