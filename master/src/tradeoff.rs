@@ -886,6 +886,13 @@ mod tests {
                 true,
             ),
             (
+                "tradeoff-biaxial-10mm.csv",
+                include_str!("../../docs/tradeoff-biaxial-10mm.csv"),
+                8,
+                1,
+                true,
+            ),
+            (
                 "tradeoff-biaxial-1mm.csv",
                 include_str!("../../docs/tradeoff-biaxial-1mm.csv"),
                 18,
