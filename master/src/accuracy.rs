@@ -42,8 +42,8 @@
 //! job is never planned from a table of another kind: it then runs with the tight reference
 //! settings, with a warning. No table speaks for F_res: the post-peak sweep
 //! (`docs/tradeoff-scene-a-post-peak.md`, scene A to 0.12 m) found the collapse itself
-//! unconverged in the load step (the default 274 % off the tight reference on F_res, load
-//! step x4 70x, the reference failing at 0.117 m), and so did the whole biaxial example
+//! unconverged in the load step (the default 435 % off the tight reference on F_res, load
+//! step x4 85x, the reference failing at 0.1166 m), and so did the whole biaxial example
 //! to 5 %, mid-softening (`docs/tradeoff-biaxial-5mm.md`: the tight reference's F_res 13 %
 //! below the default's, the load step moving it without a trend). On its residual plateau
 //! at 10 % (`docs/tradeoff-biaxial-10mm.md`) every row is within 3.2-8.5 % of the reference,
