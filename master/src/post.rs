@@ -42,7 +42,7 @@ mod tests {
 }
 
 /// Relative slack of the linear range's end: a point within it counts as on the end.
-pub const RANGE_SLACK: f64 = 1e-9;
+const RANGE_SLACK: f64 = 1e-9;
 
 /// What the paper reads off a load-displacement curve (THEORY.md section 4, scene A).
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]

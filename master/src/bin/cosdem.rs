@@ -466,7 +466,6 @@ fn study(what: StudyWhat) -> Result<()> {
         tolerance: a.tolerance,
         threads: a.threads,
         reuse: a.reuse,
-        linear_range: job.output.linear_range,
     };
     println!("RVE-size study: {} sizes -> {}", settings.sizes.len(), dir.display());
     let study = rve_size(&job, &settings, &dir)?;

@@ -4,8 +4,8 @@
 //! sticking contact as elastic. Once contacts slide the relaxed response is much softer than
 //! that tangent, and Newton with it contracts only by about `1 - K_true / K_paper` per
 //! iteration: on the biaxial example 8-14 iterations per step before the peak and up to 21,
-//! the cap, past it (docs/tradeoff-biaxial-5mm.md). The relaxation answers are what they are; the
-//! tangent is only the iteration matrix, so it may be improved from what the iterations
+//! the cap, past it (docs/tradeoff-biaxial-5mm.md). The relaxation answers are what they are;
+//! the tangent is only the iteration matrix, so it may be improved from what the iterations
 //! already measured. Measured value (docs/substep-biaxial.md): before the peak 3-4 iterations
 //! per step and half the DEM steps; past the peak none (the updates end at the first stall).
 //! Off by default.
@@ -87,9 +87,9 @@ pub fn metric(c: &Tangent) -> [f64; N] {
 /// unchanged on every direction `u` with `(B^T de) . u = 0`. Bounding against `c0`, not
 /// against the current `B`, keeps repeated updates along one direction from compounding.
 /// `step` is the step's own strain increment at this point: a change below
-/// [`MIN_RELATIVE_STEP`] of its size is relaxation noise, not a slope. Returns false (and leaves `b`
-/// alone) when the step is too small, the work along it is not positive under `b` or `c0`, or
-/// anything is not finite.
+/// [`MIN_RELATIVE_STEP`] of its size is relaxation noise, not a slope. Returns false (and
+/// leaves `b` alone) when the step is too small, the work along it is not positive under `b`
+/// or `c0`, or anything is not finite.
 pub fn directional_secant(
     b: &mut Tangent,
     c0: &Tangent,

@@ -38,8 +38,6 @@ pub struct RveSizeSettings {
     pub tolerance: f64,
     /// Runs side by side (0: one per core).
     pub threads: usize,
-    /// Upper end of the linear range for E (m); the paper's 0.01.
-    pub linear_range: f64,
     /// Read a size's curve from `curves/curve_<V>.csv` when that file exists instead of
     /// running it again ([`reused_size`]).
     pub reuse: bool,
@@ -47,14 +45,7 @@ pub struct RveSizeSettings {
 
 impl Default for RveSizeSettings {
     fn default() -> Self {
-        Self {
-            sizes: Vec::new(),
-            radius: None,
-            tolerance: 0.01,
-            threads: 0,
-            linear_range: 0.01,
-            reuse: false,
-        }
+        Self { sizes: Vec::new(), radius: None, tolerance: 0.01, threads: 0, reuse: false }
     }
 }
 
@@ -227,7 +218,7 @@ pub fn run_size(
         radius,
         discs: material.disc_count(),
         steps: obs.points.len() as u64,
-        metrics: CurveMetrics::from_curve(&obs.points, settings.linear_range),
+        metrics: CurveMetrics::from_curve(&obs.points, job.output.linear_range),
         dem_steps: obs.dem_steps,
         wall_seconds: t0.elapsed().as_secs_f64(),
         status,
@@ -282,7 +273,7 @@ pub fn reused_size(
         radius,
         discs,
         steps: points.len() as u64,
-        metrics: CurveMetrics::from_curve(&points, settings.linear_range),
+        metrics: CurveMetrics::from_curve(&points, job.output.linear_range),
         dem_steps,
         wall_seconds: 0.0,
         status,
