@@ -48,7 +48,11 @@
 //! below the default's, the load step moving it without a trend). On its residual plateau
 //! at 10 % (`docs/tradeoff-biaxial-10mm.md`) every row is within 3.2-8.5 % of the reference,
 //! cheaper rows closer than the default: scatter of the plateau minimum, no knob's trend to
-//! plan from. So a plan predicts F_u and E and warns that F_res is not covered.
+//! plan from. Averaged over three specimens (`docs/tradeoff-biaxial-10mm-specimens.md`) the
+//! scatter has a size (the default's paired differences: 5 % standard deviation) and the
+//! load step a bias (+3-7 % for every row at the job's step), but the knobs' own effects on
+//! F_res stay within two standard errors. So a plan predicts F_u and E and warns that F_res
+//! is not covered.
 //!
 //! # What it takes over, and the assembly size
 //! With `accuracy`, the knobs of [`KNOBS`] are set by the choice (to a measured setting or to

@@ -67,6 +67,9 @@ pub mod run;
 pub mod rve;
 /// Loading, linear solves, Newton-Raphson with step cutting, step observers.
 pub mod solve;
+/// Speed against accuracy averaged over specimens (packing seeds):
+/// `cosdem bench tradeoff-specimens`.
+pub mod specimens;
 /// Parameter studies over whole runs: the RVE-size study (Eqs. 30-32), `cosdem study`.
 pub mod study;
 /// Symmetric scenes on a half or quarter mesh: the reduced rectangle and its axis conditions.

@@ -31,11 +31,17 @@ pub struct Variant {
 impl Variant {
     /// A file-system-safe name (`relaxation.tolerance=1e-3` -> `relaxation.tolerance_1e-3`).
     pub fn slug(&self) -> String {
-        format!("{}_{}", self.knob, self.setting)
-            .chars()
-            .map(|c| if c.is_ascii_alphanumeric() || c == '.' || c == '-' { c } else { '_' })
-            .collect()
+        slug(self.knob, &self.setting)
     }
+}
+
+/// The run directory's name of a knob and setting (`relaxation.tolerance`, `1e-3` ->
+/// `relaxation.tolerance_1e-3`): what `out/runs/` holds for each row.
+pub fn slug(knob: &str, setting: &str) -> String {
+    format!("{knob}_{setting}")
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() || c == '.' || c == '-' { c } else { '_' })
+        .collect()
 }
 
 /// The result of one variant, compared with the reference.
@@ -114,7 +120,7 @@ fn relative(value: Option<f64>, reference: Option<f64>) -> Option<f64> {
 }
 
 /// Linear interpolation of a curve sorted by displacement; `None` outside its range.
-fn interpolate(curve: &[(f64, f64)], d: f64) -> Option<f64> {
+pub(crate) fn interpolate(curve: &[(f64, f64)], d: f64) -> Option<f64> {
     let first = curve.first()?;
     if d < first.0 {
         // Every curve starts at (0, 0) before its first step.
@@ -710,7 +716,7 @@ pub fn sweep(
 }
 
 /// The reference's metrics, curve and wall time (the sweep's first run).
-type Reference = (CurveMetrics, Vec<(f64, f64)>, f64);
+pub(crate) type Reference = (CurveMetrics, Vec<(f64, f64)>, f64);
 
 /// Runs one variant into `out/runs/<slug>` and compares it with the reference (the first
 /// run becomes the reference).
@@ -890,6 +896,20 @@ mod tests {
                 include_str!("../../docs/tradeoff-biaxial-10mm.csv"),
                 8,
                 1,
+                true,
+            ),
+            (
+                "tradeoff-biaxial-10mm-specimens.csv",
+                include_str!("../../docs/tradeoff-biaxial-10mm-specimens.csv"),
+                6,
+                0,
+                true,
+            ),
+            (
+                "tradeoff-biaxial-10mm-seed-8.csv",
+                include_str!("../../docs/tradeoff-biaxial-10mm-seed-8.csv"),
+                8,
+                0,
                 true,
             ),
             (

@@ -8,6 +8,7 @@
 //! cosdem bench overhead|scaling|fe|all [OPTIONS]
 //! cosdem bench tradeoff JOB.toml [--displacement D] [--out DIR]
 //! cosdem bench tradeoff-plot DIR/tradeoff.csv [--out PNG] [--title T]
+//! cosdem bench tradeoff-specimens SWEEP_DIR SWEEP_DIR... [--out DIR] [--title T]
 //! cosdem plot RUN_DIR
 //! ```
 //! `run` checkpoints into `RUN/checkpoint.bin` (every `[output] checkpoint_every` steps);
@@ -85,6 +86,45 @@ enum BenchWhat {
     /// Redraw the Pareto plot of an existing tradeoff.csv without running anything, and print
     /// its Markdown table (Pareto column filled).
     TradeoffPlot(TradeoffPlotArgs),
+    /// Average the sweeps of several specimens (one `bench tradeoff` directory per packing
+    /// seed): specimen-mean F_u, F_res and E against the mean of the references, with the
+    /// paired differences' standard errors; writes tradeoff.csv, tradeoff.md and pareto.png.
+    TradeoffSpecimens(TradeoffSpecimensArgs),
+}
+
+#[derive(clap::Args)]
+struct TradeoffSpecimensArgs {
+    /// The sweep directories (each holds tradeoff.csv and runs/), at least two.
+    #[arg(required = true, num_args = 2..)]
+    sweeps: Vec<PathBuf>,
+    /// Output directory.
+    #[arg(long, default_value = "runs/tradeoff-specimens")]
+    out: PathBuf,
+    /// The table's title.
+    #[arg(long, default_value = "Speed against accuracy averaged over specimens")]
+    title: String,
+}
+
+fn tradeoff_specimens(a: TradeoffSpecimensArgs) -> Result<()> {
+    use cosdem_master::specimens::{average, markdown, read_sweep};
+    use cosdem_master::tradeoff::{PARETO_FILE, csv, write_pareto};
+    let specimens = a.sweeps.iter().map(|d| read_sweep(d)).collect::<Result<Vec<_>, _>>()?;
+    let averaged = average(&specimens)?;
+    std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
+    let write = |name: &str, text: String| {
+        let path = a.out.join(name);
+        std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))
+    };
+    write("tradeoff.csv", csv(&averaged.rows))?;
+    let md = markdown(&a.title, &averaged);
+    write("tradeoff.md", md.clone())?;
+    let png = a.out.join(PARETO_FILE);
+    if let Err(e) = write_pareto(&averaged.rows, &a.title, &png) {
+        eprintln!("warning: Pareto plot: {e}");
+    }
+    print!("{md}");
+    eprintln!("{} rows -> {}", averaged.rows.len(), a.out.display());
+    Ok(())
 }
 
 #[derive(clap::Args)]
@@ -280,6 +320,7 @@ fn bench(what: BenchWhat) -> Result<()> {
         }
         BenchWhat::Tradeoff(a) => tradeoff(a),
         BenchWhat::TradeoffPlot(a) => tradeoff_plot(a),
+        BenchWhat::TradeoffSpecimens(a) => tradeoff_specimens(a),
         BenchWhat::All(c) => {
             overhead(&workload(400, 4, 10, &c)?, out).map_err(e)?;
             scaling(&workload(400, 64, 2, &c)?, out).map_err(e)?;
