@@ -24,7 +24,8 @@ pub struct Specimen {
     pub label: String,
     /// The sweep's rows as `tradeoff.csv` has them; the first is the reference.
     pub rows: Vec<Row>,
-    /// The `(displacement, load)` curve of each row (empty when its run left none).
+    /// The `(displacement, load)` curve of each row (empty when its run left none; a row
+    /// past the end of this list has none either).
     pub curves: Vec<Vec<(f64, f64)>>,
 }
 
@@ -133,6 +134,11 @@ pub fn mean_curve(curves: &[&[(f64, f64)]], grid: &[(f64, f64)]) -> Vec<(f64, f6
         .collect()
 }
 
+/// Row `i`'s curve of a specimen (empty when it has none).
+fn curve_of(s: &Specimen, i: usize) -> &[(f64, f64)] {
+    s.curves.get(i).map_or(&[], Vec::as_slice)
+}
+
 /// Averages the sweeps of several specimens (see the module's docs). Rows are matched by
 /// knob and setting; the first specimen's order is kept; a row some specimen lacks is
 /// dropped (and named in [`Averaged::dropped`]).
@@ -156,7 +162,7 @@ pub fn average(specimens: &[Specimen]) -> Result<Averaged, SpecimensError> {
         s.rows.iter().position(|o| o.knob == r.knob && o.setting == r.setting)
     };
     // The references' mean curve on the first reference's grid is every row's grid.
-    let grid = &specimens[0].curves[0];
+    let grid = curve_of(&specimens[0], 0);
     let mut reference: Option<tradeoff::Reference> = None;
     let (mut rows, mut spread, mut dropped) = (Vec::new(), Vec::new(), Vec::new());
     for r in &specimens[0].rows {
@@ -166,7 +172,7 @@ pub fn average(specimens: &[Specimen]) -> Result<Averaged, SpecimensError> {
         };
         let per: Vec<&Row> = specimens.iter().zip(&at).map(|(s, &i)| &s.rows[i]).collect();
         let curves: Vec<&[(f64, f64)]> =
-            specimens.iter().zip(&at).map(|(s, &i)| s.curves[i].as_slice()).collect();
+            specimens.iter().zip(&at).map(|(s, &i)| curve_of(s, i)).collect();
         let metrics = CurveMetrics {
             peak_load: mean(&per.iter().map(|r| r.metrics.peak_load).collect::<Vec<_>>()),
             peak_displacement: mean(

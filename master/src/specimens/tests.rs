@@ -126,6 +126,10 @@ fn too_few_specimens_or_no_reference_are_refused() {
     let a = specimen("s1", vec![row("reference", "tight", 1.0, 1.0, None, 1.0)], vec![vec![]]);
     let e = average(std::slice::from_ref(&a)).unwrap_err();
     assert!(e.to_string().contains("at least 2 sweeps, got 1"), "{e}");
+    // Curves missing altogether are empty curves, not a panic.
+    let no_curves = specimen("s3", a.rows.clone(), Vec::new());
+    let avg = average(&[a.clone(), no_curves]).unwrap();
+    assert_eq!(avg.rows[0].errors.curve, None);
     let e = average(&[a.clone(), a.clone()]).unwrap_err();
     assert_eq!(e.to_string(), "specimen s1 is given twice");
     let b = specimen("s2", vec![row("default", "as given", 1.0, 1.0, None, 1.0)], vec![vec![]]);
