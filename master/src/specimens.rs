@@ -96,14 +96,15 @@ pub struct Averaged {
     pub dropped: Vec<String>,
 }
 
-fn mean(v: &[f64]) -> f64 {
-    v.iter().sum::<f64>() / v.len() as f64
+fn mean(v: impl ExactSizeIterator<Item = f64>) -> f64 {
+    let n = v.len() as f64;
+    v.sum::<f64>() / n
 }
 
 /// The mean of every specimen's value, `None` if any specimen lacks it.
 fn mean_of(values: impl Iterator<Item = Option<f64>>) -> Option<f64> {
     let v: Option<Vec<f64>> = values.collect();
-    v.filter(|v| !v.is_empty()).map(|v| mean(&v))
+    v.filter(|v| !v.is_empty()).map(|v| mean(v.into_iter()))
 }
 
 /// Paired relative differences `(x_i - r_i) / mean(r)`, their mean and standard error.
@@ -111,12 +112,12 @@ fn difference(x: &[Option<f64>], r: &[Option<f64>]) -> Option<Difference> {
     let pairs: Option<Vec<(f64, f64)>> =
         x.iter().zip(r).map(|(x, r)| Some(((*x)?, (*r)?))).collect();
     let pairs = pairs.filter(|p| p.len() >= 2)?;
-    let rm = mean(&pairs.iter().map(|p| p.1).collect::<Vec<_>>());
+    let rm = mean(pairs.iter().map(|p| p.1));
     if rm == 0.0 || !rm.is_finite() {
         return None;
     }
     let d: Vec<f64> = pairs.iter().map(|(x, r)| (x - r) / rm.abs()).collect();
-    let m = mean(&d);
+    let m = mean(d.iter().copied());
     let n = d.len() as f64;
     let var = d.iter().map(|v| (v - m) * (v - m)).sum::<f64>() / (n - 1.0);
     Some(Difference { mean: m, standard_error: (var / n).sqrt() })
@@ -129,7 +130,7 @@ pub fn mean_curve(curves: &[&[(f64, f64)]], grid: &[(f64, f64)]) -> Vec<(f64, f6
         .map_while(|&(d, _)| {
             let loads: Option<Vec<f64>> =
                 curves.iter().map(|c| tradeoff::interpolate(c, d)).collect();
-            loads.map(|l| (d, mean(&l)))
+            loads.map(|l| (d, mean(l.into_iter())))
         })
         .collect()
 }
@@ -164,6 +165,14 @@ pub fn average(specimens: &[Specimen]) -> Result<Averaged, SpecimensError> {
     // The references' mean curve on the first reference's grid is every row's grid.
     let grid = curve_of(&specimens[0], 0);
     let mut reference: Option<tradeoff::Reference> = None;
+    // Each property of the given rows, in the specimens' order, and the references' rows.
+    let pick = |rows: &[&Row], f: fn(&CurveMetrics) -> Option<f64>| -> Vec<Option<f64>> {
+        rows.iter().map(|r| f(&r.metrics)).collect()
+    };
+    let fu: fn(&CurveMetrics) -> Option<f64> = |m| Some(m.peak_load);
+    let fres: fn(&CurveMetrics) -> Option<f64> = |m| m.residual_load;
+    let e: fn(&CurveMetrics) -> Option<f64> = |m| m.stiffness;
+    let refs: Vec<&Row> = specimens.iter().map(|s| &s.rows[0]).collect();
     let (mut rows, mut spread, mut dropped) = (Vec::new(), Vec::new(), Vec::new());
     for r in &specimens[0].rows {
         let Some(at) = specimens.iter().map(|s| find(s, r)).collect::<Option<Vec<usize>>>() else {
@@ -174,10 +183,8 @@ pub fn average(specimens: &[Specimen]) -> Result<Averaged, SpecimensError> {
         let curves: Vec<&[(f64, f64)]> =
             specimens.iter().zip(&at).map(|(s, &i)| curve_of(s, i)).collect();
         let metrics = CurveMetrics {
-            peak_load: mean(&per.iter().map(|r| r.metrics.peak_load).collect::<Vec<_>>()),
-            peak_displacement: mean(
-                &per.iter().map(|r| r.metrics.peak_displacement).collect::<Vec<_>>(),
-            ),
+            peak_load: mean(per.iter().map(|r| r.metrics.peak_load)),
+            peak_displacement: mean(per.iter().map(|r| r.metrics.peak_displacement)),
             residual_load: mean_of(per.iter().map(|r| r.metrics.residual_load)),
             stiffness: mean_of(per.iter().map(|r| r.metrics.stiffness)),
             stiffness_50: mean_of(per.iter().map(|r| r.metrics.stiffness_50)),
@@ -202,13 +209,6 @@ pub fn average(specimens: &[Specimen]) -> Result<Averaged, SpecimensError> {
             errors,
             speedup: *rt / wall.max(1e-9),
         });
-        let refs: Vec<&Row> = specimens.iter().map(|s| &s.rows[0]).collect();
-        let pick = |rows: &[&Row], f: fn(&CurveMetrics) -> Option<f64>| -> Vec<Option<f64>> {
-            rows.iter().map(|r| f(&r.metrics)).collect()
-        };
-        let fu = |m: &CurveMetrics| Some(m.peak_load);
-        let fres = |m: &CurveMetrics| m.residual_load;
-        let e = |m: &CurveMetrics| m.stiffness;
         spread.push(Spread {
             per_specimen: per.iter().map(|r| (*r).clone()).collect(),
             peak: difference(&pick(&per, fu), &pick(&refs, fu)),

@@ -113,7 +113,8 @@ fn tradeoff_specimens(a: TradeoffSpecimensArgs) -> Result<()> {
     std::fs::create_dir_all(&a.out).with_context(|| format!("creating {}", a.out.display()))?;
     let write = |name: &str, text: String| {
         let path = a.out.join(name);
-        std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))
+        cosdem_master::output::write_atomic(&path, text.as_bytes())
+            .with_context(|| format!("writing {}", path.display()))
     };
     write("tradeoff.csv", csv(&averaged.rows))?;
     let md = markdown(&a.title, &averaged);
