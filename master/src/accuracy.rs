@@ -51,8 +51,11 @@
 //! plan from. Averaged over three specimens (`docs/tradeoff-biaxial-10mm-specimens.md`) the
 //! scatter has a size (the default's paired differences: 5 % standard deviation) and the
 //! load step a bias (+3-7 % for every row at the job's step), but the knobs' own effects on
-//! F_res stay within two standard errors. So a plan predicts F_u and E and warns that F_res
-//! is not covered.
+//! F_res stay within two standard errors. That bias is the load step's
+//! (`docs/load-step-biaxial.md`: at half the job's step, with the job's relaxation, the three
+//! specimens are within 2.6 % of the reference on F_res), and a plan only ever saves steps
+//! (a candidate must save [`MIN_SAVING`]), never halves the load step. So a plan predicts
+//! F_u and E and warns that F_res is not covered.
 //!
 //! # What it takes over, and the assembly size
 //! With `accuracy`, the knobs of [`KNOBS`] are set by the choice (to a measured setting or to
