@@ -263,6 +263,14 @@ pub const SUBSTEP: f64 = 5e-4;
 /// setting. A DEM job only (an analytical material has no speed knobs but the load step).
 pub fn variants(base: &Job) -> Vec<Variant> {
     let mut v = vec![reference(base), with(base, "default", "as given", |_| {})];
+    // A move to a setting the job already has would run the default again at its full cost.
+    v.extend(knob_moves(base).into_iter().filter(|x| x.job != *base));
+    v
+}
+
+/// Each speed knob moved alone from the job's setting (some may leave the job unchanged).
+fn knob_moves(base: &Job) -> Vec<Variant> {
+    let mut v = Vec::new();
     let step = |f: f64| {
         move |j: &mut Job| {
             if let Some(inc) = &mut j.loading.increment {
@@ -290,8 +298,7 @@ pub fn variants(base: &Job) -> Vec<Variant> {
     }) else {
         return v;
     };
-    // A setting the job already has would repeat the default row: left out.
-    for tol in [1e-3, 3e-4].into_iter().filter(|t| *t != a.relaxation.tolerance) {
+    for tol in [1e-3, 3e-4] {
         v.push(with(base, "relaxation.tolerance", format!("{tol:e}"), move |j| {
             if let Some(a) = assembly_mut(j) {
                 a.relaxation.tolerance = tol;
@@ -306,20 +313,18 @@ pub fn variants(base: &Job) -> Vec<Variant> {
             }
         }));
     }
-    for scale in [4.0, 16.0].into_iter().filter(|s| *s != a.relaxation.density_scale) {
+    for scale in [4.0, 16.0] {
         v.push(with(base, "relaxation.density_scale", scale, move |j| {
             if let Some(a) = assembly_mut(j) {
                 a.relaxation.density_scale = scale;
             }
         }));
     }
-    if !matches!(a.relaxation.driver, Driver::Fire { .. }) {
-        v.push(with(base, "relaxation.driver", "fire", |j| {
-            if let Some(a) = assembly_mut(j) {
-                a.relaxation.driver = Driver::fire();
-            }
-        }));
-    }
+    v.push(with(base, "relaxation.driver", "fire", |j| {
+        if let Some(a) = assembly_mut(j) {
+            a.relaxation.driver = Driver::fire();
+        }
+    }));
     for (name, tangent) in [
         ("paper", TangentKind::Paper),
         ("sliding_aware", TangentKind::SlidingAware),
@@ -334,13 +339,11 @@ pub fn variants(base: &Job) -> Vec<Variant> {
             }));
         }
     }
-    if !a.warm_start {
-        v.push(with(base, "warm_start", "true", |j| {
-            if let Some(a) = assembly_mut(j) {
-                a.warm_start = true;
-            }
-        }));
-    }
+    v.push(with(base, "warm_start", "true", |j| {
+        if let Some(a) = assembly_mut(j) {
+            a.warm_start = true;
+        }
+    }));
     // Item 3's skipping: a point deformed less than the threshold since its last relaxation
     // answers from its tangent (1e-3: a tenth to a half of these scenes' strain per step);
     // the elastic shortcut answers from the tangent while every contact sticks.
