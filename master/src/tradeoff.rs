@@ -155,15 +155,32 @@ pub fn curve_error(reference: &[(f64, f64)], curve: &[(f64, f64)]) -> Option<f64
 }
 
 /// The errors of a run's metrics and curve against the reference's.
+///
+/// Where the reference stopped before the run did (a reference that failed past the peak),
+/// F_u and F_res are the run's over the reference's range: F_res is a minimum over the path,
+/// and the minimum of a longer path is not the same statistic (a biaxial run's plateau
+/// minimum at 8.95 mm against a reference that stopped at 7.575 mm: 3.86 %, where the two
+/// over the same range differ by 0.41 %, docs/load-step-biaxial.md). E and the curve error
+/// are over the reference's range already.
 pub fn compare(
     reference: (&CurveMetrics, &[(f64, f64)]),
     run: (&CurveMetrics, &[(f64, f64)]),
 ) -> Errors {
     let (rm, rc) = reference;
     let (m, c) = run;
+    let within = match (rc.last(), c.last()) {
+        (Some(&(end, _)), Some(&(last, _))) if end < last => {
+            let n = c.partition_point(|p| p.0 <= end * (1.0 + 1e-9));
+            // The linear range does not matter here: only F_u and F_res are taken.
+            Some(CurveMetrics::from_curve(&c[..n], 0.0))
+        }
+        _ => None,
+    };
+    let m_peak = within.map_or(m.peak_load, |w| w.peak_load);
+    let m_residual = within.map_or(m.residual_load, |w| w.residual_load);
     Errors {
-        peak: relative(Some(m.peak_load), Some(rm.peak_load)),
-        residual: relative(m.residual_load, rm.residual_load),
+        peak: relative(Some(m_peak), Some(rm.peak_load)),
+        residual: relative(m_residual, rm.residual_load),
         stiffness: relative(m.stiffness, rm.stiffness),
         curve: curve_error(rc, c),
     }
@@ -1025,6 +1042,31 @@ mod tests {
         assert!((e.stiffness.unwrap() - 0.1).abs() < 1e-12);
         assert_eq!(e.worst(), None);
         assert!((e.worst_present().unwrap() - 0.1).abs() < 1e-12);
+    }
+
+    /// A reference that stopped early is compared over its own range: the run's F_u and
+    /// F_res are taken from its points up to the reference's last displacement, so a lower
+    /// minimum the run reaches later does not count; a reference that went as far as the run
+    /// leaves the run's metrics as they are.
+    #[test]
+    fn an_early_reference_compares_over_its_range() {
+        // Peak 100 at 1, then 60 at 3 (within the reference's range) and 40 at 5 (beyond).
+        let run: Vec<(f64, f64)> =
+            [(1.0, 100.0), (2.0, 80.0), (3.0, 60.0), (4.0, 70.0), (5.0, 40.0)]
+                .map(|(d, f)| (d * 1e-3, f))
+                .to_vec();
+        let m = CurveMetrics::from_curve(&run, 1e-3);
+        assert_eq!(m.residual_load, Some(40.0));
+        let reference = [(1e-3, 100.0), (2e-3, 70.0), (3e-3, 60.0), (4e-3, 75.0)];
+        let rm = CurveMetrics::from_curve(&reference, 1e-3);
+        assert_eq!(rm.residual_load, Some(60.0));
+        let e = compare((&rm, &reference), (&m, &run));
+        assert_eq!(e.residual, Some(0.0), "the run's minimum up to 4 mm is 60, as the reference's");
+        assert_eq!(e.peak, Some(0.0));
+        // The same reference run to the end: the run's whole-path minimum counts (40 vs 60).
+        let longer = [reference.to_vec(), vec![(5e-3, 60.0)]].concat();
+        let e = compare((&rm, &longer), (&m, &run));
+        assert!((e.residual.unwrap() - 1.0 / 3.0).abs() < 1e-15);
     }
 
     /// `--skip` names a variant by knob or by knob=setting, nothing else.
