@@ -153,6 +153,7 @@ pub fn run_job(
     let (mut material, n) = material_for(job, workers, &ids, None)?;
     writer.set_workers(n);
     let outcome = solver.run(material.as_mut(), &mut writer);
+    writer.add_uncommitted_dem_steps(solver.uncommitted_dem_steps());
     writer.finish(outcome.as_ref().map(|_| ()).map_err(|e| e.to_string()))?;
     Ok((writer.summary().clone(), writer.curve().to_vec()))
 }

@@ -327,6 +327,41 @@ fn dem_steps_count_every_evaluation() {
     assert!(reported > 2 * 7 * points * 3, "{reported} for {points} points");
 }
 
+/// A step that ends the run (cut below the minimum increment) still cost its relaxations:
+/// none of its attempts reaches a [`StepReport`], so the solver keeps them as
+/// `uncommitted_dem_steps` for the run's summary (a failed biaxial reference lost about 12
+/// minutes of attempts from its count). Every evaluation is counted once: the reports' sum
+/// plus the uncommitted ones is what the material was asked for, and the failed step did
+/// cost some (a first step that runs out of its one iteration at every cut).
+#[test]
+fn a_failed_step_keeps_its_dem_steps() {
+    let settings = SolverSettings {
+        steps: 2,
+        max_iterations: 1,
+        force_tolerance: 1e-14,
+        min_increment_fraction: 0.25,
+        ..Default::default()
+    };
+    let mut solver = Solver::new(panel(-0.04), settings).unwrap();
+    let mut asked = 0;
+    let mut mat = Adjusted(
+        SofteningElastic { elastic: elastic(), beta: 400.0 },
+        |_: TrialId, _: &[MaterialInput], r: &mut [MicroResponse]| {
+            for x in r.iter_mut() {
+                x.diagnostics.steps = 7;
+            }
+            asked += 7 * r.len() as u64;
+        },
+    );
+    let mut log: Vec<StepReport> = Vec::new();
+    let err = solver.run(&mut mat, &mut log).unwrap_err();
+    assert!(matches!(err, Error::StepTooSmall { .. }), "{err}");
+    let reported: u64 = log.iter().map(|s| s.dem_steps).sum();
+    let pending = solver.uncommitted_dem_steps();
+    assert!(pending > 0, "the failed step's attempts were not kept");
+    assert_eq!(reported + pending, asked);
+}
+
 /// The softening law's stresses with the elastic tangent: the DEM situation in miniature (a
 /// relaxed assembly is softer than its contact-stiffness tangent), so Newton with the
 /// material's tangent contracts only by `1 - K_true / K_elastic` per iteration.

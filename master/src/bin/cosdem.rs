@@ -683,6 +683,7 @@ fn run(args: RunArgs) -> Result<()> {
         solver.run(&mut material, &mut observer)
     };
     bar.finish_and_clear();
+    writer.add_uncommitted_dem_steps(solver.uncommitted_dem_steps());
     let interrupted = matches!(outcome, Err(cosdem_master::Error::Interrupted { .. }));
     if interrupted {
         writer.finish_interrupted()?;

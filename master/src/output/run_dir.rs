@@ -289,6 +289,13 @@ impl RunWriter {
         self.summary.workers = n;
     }
 
+    /// Adds DEM steps that no step row carries to the summary's count: the failed attempts
+    /// of the step that ended a run ([`crate::solve::Solver::uncommitted_dem_steps`]), so
+    /// that a failed run's cost is all it spent (`curve.csv` keeps the committed steps').
+    pub fn add_uncommitted_dem_steps(&mut self, n: u64) {
+        self.summary.dem_steps = self.summary.dem_steps.saturating_add(n);
+    }
+
     /// Marks the run finished (or failed, with the reason) and writes the summary.
     pub fn finish(&mut self, outcome: std::result::Result<(), String>) -> Result<()> {
         self.summary.status = match outcome {

@@ -333,6 +333,13 @@ impl Solver {
         &self.pattern
     }
 
+    /// DEM steps of the relaxations since the last committed step: the failed attempts of
+    /// the step that ended a run (`StepTooSmall`), which no [`StepReport`] carries. Zero
+    /// after a run that finished or was interrupted between steps.
+    pub fn uncommitted_dem_steps(&self) -> u64 {
+        self.evaluated_steps.get()
+    }
+
     /// Converged load factor.
     pub fn load_factor(&self) -> f64 {
         self.lambda

@@ -219,7 +219,8 @@ pub fn run_size(
         discs: material.disc_count(),
         steps: obs.points.len() as u64,
         metrics: CurveMetrics::from_curve(&obs.points, job.output.linear_range),
-        dem_steps: obs.dem_steps,
+        // The failed attempts of a step that ended the run cost DEM steps too.
+        dem_steps: obs.dem_steps + solver.uncommitted_dem_steps(),
         wall_seconds: t0.elapsed().as_secs_f64(),
         status,
     })
