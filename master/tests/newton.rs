@@ -281,13 +281,7 @@ fn scene_b_softening_panel_runs_to_the_end() {
 /// so the run reaches the full load.
 #[test]
 fn tolerated_residual_accepts_steps_that_ran_out_of_iterations() {
-    let strict = SolverSettings {
-        steps: 2,
-        max_iterations: 1,
-        force_tolerance: 1e-14,
-        min_increment_fraction: 0.25,
-        ..Default::default()
-    };
+    let strict = one_iteration_per_attempt();
     let mut mat = SofteningElastic { elastic: elastic(), beta: 400.0 };
     let mut log: Vec<StepReport> = Vec::new();
     let mut solver = Solver::new(panel(-0.04), strict.clone()).unwrap();
@@ -327,6 +321,19 @@ fn dem_steps_count_every_evaluation() {
     assert!(reported > 2 * 7 * points * 3, "{reported} for {points} points");
 }
 
+/// Two steps of the softening panel with one Newton iteration per attempt and an
+/// unreachable force tolerance: every attempt fails, so the first step is cut to 1/4 and
+/// ends the run (unless `tolerated_residual` accepts it).
+fn one_iteration_per_attempt() -> SolverSettings {
+    SolverSettings {
+        steps: 2,
+        max_iterations: 1,
+        force_tolerance: 1e-14,
+        min_increment_fraction: 0.25,
+        ..Default::default()
+    }
+}
+
 /// A step that ends the run (cut below the minimum increment) still cost its relaxations:
 /// none of its attempts reaches a [`StepReport`], so the solver keeps them as
 /// `uncommitted_dem_steps` for the run's summary (a failed biaxial reference lost about 12
@@ -335,13 +342,7 @@ fn dem_steps_count_every_evaluation() {
 /// cost some (a first step that runs out of its one iteration at every cut).
 #[test]
 fn a_failed_step_keeps_its_dem_steps() {
-    let settings = SolverSettings {
-        steps: 2,
-        max_iterations: 1,
-        force_tolerance: 1e-14,
-        min_increment_fraction: 0.25,
-        ..Default::default()
-    };
+    let settings = one_iteration_per_attempt();
     let mut solver = Solver::new(panel(-0.04), settings).unwrap();
     let mut asked = 0;
     let mut mat = Adjusted(
