@@ -41,8 +41,9 @@ mod tests {
     }
 }
 
-/// Relative slack of the linear range's end: a point within it counts as on the end.
-const RANGE_SLACK: f64 = 1e-9;
+/// Relative slack of a range's end on a curve of summed increments (the linear range; a
+/// stopped reference's last displacement): a point within it counts as on the end.
+pub(crate) const RANGE_SLACK: f64 = 1e-9;
 
 /// What the paper reads off a load-displacement curve (THEORY.md section 4, scene A).
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]

@@ -170,7 +170,8 @@ pub fn compare(
     let (m, c) = run;
     let within = match (rc.last(), c.last()) {
         (Some(&(end, _)), Some(&(last, _))) if end < last => {
-            let n = c.partition_point(|p| p.0 <= end * (1.0 + 1e-9));
+            // The reference's last point counts whatever the round-off of the summed increments.
+            let n = c.partition_point(|p| p.0 <= end * (1.0 + crate::post::RANGE_SLACK));
             // The linear range does not matter here: only F_u and F_res are taken.
             Some(CurveMetrics::from_curve(&c[..n], 0.0))
         }

@@ -336,7 +336,7 @@ fn one_iteration_per_attempt() -> SolverSettings {
 
 /// A step that ends the run (cut below the minimum increment) still cost its relaxations:
 /// none of its attempts reaches a [`StepReport`], so the solver keeps them as
-/// `uncommitted_dem_steps` for the run's summary (a failed biaxial reference lost about 12
+/// `uncommitted_dem_steps` for the run's summary (a failed biaxial reference lost about 11
 /// minutes of attempts from its count). Every evaluation is counted once: the reports' sum
 /// plus the uncommitted ones is what the material was asked for, and the failed step did
 /// cost some (a first step that runs out of its one iteration at every cut).
