@@ -9,9 +9,14 @@
 //! solve is deterministic given (committed state, target), and everything else is restored
 //! exactly (bincode stores each `f64` as its bit pattern).
 //!
-//! Format: the magic `CDEMCKP1`, then one bincode (standard config) [`Checkpoint`]. The
-//! checkpoint also stores a digest of the job's physics (mesh, loading, material, Newton
-//! settings): resuming with a job whose physics changed is refused.
+//! Format: the magic `CDEMCKP2`, then one bincode (standard config) [`Checkpoint`]. The
+//! checkpoint also stores a digest of the job's physics (mesh, loading, material) and one of
+//! its Newton settings: resuming with a job whose physics changed is refused, and so is one
+//! whose Newton settings changed unless the resume says so (`--newton-changed`): the steps
+//! already done stay as they were and only the steps to come are solved with the new
+//! settings (a run that stalls past a peak can go on with more iterations or another
+//! tolerance instead of starting again), so that run is no longer the uninterrupted run of
+//! either job.
 
 use crate::error::{Error, Result};
 use crate::job::Job;
@@ -25,7 +30,10 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-const MAGIC: &[u8; 8] = b"CDEMCKP1";
+const MAGIC: &[u8; 8] = b"CDEMCKP2";
+
+/// The header of the format before the Newton settings had a digest of their own.
+const MAGIC_1: &[u8; 8] = b"CDEMCKP1";
 
 /// The checkpoint file's name in the run directory.
 pub const FILE: &str = "checkpoint.bin";
@@ -48,6 +56,8 @@ pub struct SavedAssembly {
 pub struct Checkpoint {
     /// Digest of the job's physics ([`job_digest`]).
     pub job_digest: u64,
+    /// Digest of the job's Newton settings ([`newton_digest`]).
+    pub newton_digest: u64,
     /// The solver's state.
     pub solver: SolverState,
     /// The material's committed states (empty for stateless materials).
@@ -60,7 +70,7 @@ fn bad(path: &Path, message: String) -> Error {
 
 impl Checkpoint {
     /// Captures the solver and the material at the last committed step.
-    pub fn capture(solver: &Solver, material: &mut dyn Material, job_digest: u64) -> Result<Self> {
+    pub fn capture(solver: &Solver, material: &mut dyn Material, digests: Digests) -> Result<Self> {
         let states = material.committed_states()?.unwrap_or_default();
         let step = solver.step();
         if let Some(s) = states.iter().find(|s| s.committed_step != step) {
@@ -78,7 +88,12 @@ impl Checkpoint {
                 state: s.state,
             })
             .collect();
-        Ok(Self { job_digest, solver: solver.state(), assemblies })
+        Ok(Self {
+            job_digest: digests.job,
+            newton_digest: digests.newton,
+            solver: solver.state(),
+            assemblies,
+        })
     }
 
     /// The material's committed states, for [`Material::restore_states`].
@@ -106,8 +121,16 @@ impl Checkpoint {
     /// Reads a checkpoint written by [`Checkpoint::write`].
     pub fn read(path: &Path) -> Result<Self> {
         let bytes = std::fs::read(path).map_err(|e| bad(path, e.to_string()))?;
+        if bytes.len() >= MAGIC_1.len() && &bytes[..MAGIC_1.len()] == MAGIC_1 {
+            return Err(bad(
+                path,
+                "a checkpoint of the first format (CDEMCKP1, cosdem before 2026-12-03): resume \
+                 it with the cosdem that wrote it"
+                    .into(),
+            ));
+        }
         if bytes.len() < MAGIC.len() || &bytes[..MAGIC.len()] != MAGIC {
-            return Err(bad(path, "not a cosdem checkpoint (no CDEMCKP1 header)".into()));
+            return Err(bad(path, "not a cosdem checkpoint (no CDEMCKP2 header)".into()));
         }
         let (c, used): (Self, usize) =
             bincode::serde::decode_from_slice(&bytes[MAGIC.len()..], bincode::config::standard())
@@ -119,27 +142,72 @@ impl Checkpoint {
     }
 
     /// Refuses a checkpoint of another job's physics.
-    pub fn check_job(&self, job: &Job, path: &Path) -> Result<()> {
+    ///
+    /// `newton_changed`: the job's `[newton]` settings may differ from the checkpoint's (the
+    /// steps to come are solved with the job's; a warning is logged).
+    pub fn check_job(&self, job: &Job, path: &Path, newton_changed: bool) -> Result<()> {
         let d = job_digest(job);
         if d != self.job_digest {
             return Err(bad(
                 path,
                 format!(
                     "the checkpoint was written for another job (digest {:016x}, this job {d:016x}): \
-                     mesh, loading, material or newton settings changed",
+                     mesh, loading or material changed",
                     self.job_digest
                 ),
             ));
+        }
+        let n = newton_digest(job);
+        if n != self.newton_digest {
+            if !newton_changed {
+                return Err(bad(
+                    path,
+                    format!(
+                        "the checkpoint was written with other [newton] settings (digest \
+                         {:016x}, this job {n:016x}); resume with --newton-changed to solve the \
+                         steps to come with this job's",
+                        self.newton_digest
+                    ),
+                ));
+            }
+            tracing::warn!(
+                step = self.solver.step,
+                "[newton] settings changed at the resume: the steps from here on are solved with \
+                 the job's"
+            );
         }
         Ok(())
     }
 }
 
-/// FNV-1a digest of the job's physics: `[mesh]`, `[loading]`, `[material]`, `[newton]` as
-/// JSON. Output and worker settings may change between a run and its resume.
+/// The digests a checkpoint stores.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Digests {
+    /// [`job_digest`].
+    pub job: u64,
+    /// [`newton_digest`].
+    pub newton: u64,
+}
+
+impl Digests {
+    /// The job's.
+    pub fn of(job: &Job) -> Self {
+        Self { job: job_digest(job), newton: newton_digest(job) }
+    }
+}
+
+/// FNV-1a digest of the job's physics: `[mesh]`, `[loading]`, `[material]` as JSON. Output
+/// and worker settings may change between a run and its resume.
 pub fn job_digest(job: &Job) -> u64 {
-    let text = serde_json::to_string(&(&job.mesh, &job.loading, &job.material, &job.newton))
-        .unwrap_or_default();
+    fnv1a(&serde_json::to_string(&(&job.mesh, &job.loading, &job.material)).unwrap_or_default())
+}
+
+/// FNV-1a digest of the job's `[newton]` settings as JSON.
+pub fn newton_digest(job: &Job) -> u64 {
+    fnv1a(&serde_json::to_string(&job.newton).unwrap_or_default())
+}
+
+fn fnv1a(text: &str) -> u64 {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
     for b in text.bytes() {
         h ^= u64::from(b);
@@ -155,14 +223,14 @@ pub struct Checkpointer<O> {
     pub inner: O,
     path: PathBuf,
     every: u64,
-    digest: u64,
+    digests: Digests,
     stop: Arc<AtomicBool>,
 }
 
 impl<O: StepObserver> Checkpointer<O> {
     /// Checkpoints into `dir/checkpoint.bin`.
     pub fn new(inner: O, dir: &Path, every: usize, job: &Job, stop: Arc<AtomicBool>) -> Self {
-        Self { inner, path: dir.join(FILE), every: every as u64, digest: job_digest(job), stop }
+        Self { inner, path: dir.join(FILE), every: every as u64, digests: Digests::of(job), stop }
     }
 }
 
@@ -176,7 +244,7 @@ impl<O: StepObserver> StepObserver for Checkpointer<O> {
         let stop = inner == StepControl::Stop || self.stop.load(Ordering::SeqCst);
         if stop || (self.every > 0 && solver.step().is_multiple_of(self.every)) {
             let _s = tracing::info_span!("checkpoint", step = solver.step()).entered();
-            Checkpoint::capture(solver, material, self.digest)?.write(&self.path)?;
+            Checkpoint::capture(solver, material, self.digests)?.write(&self.path)?;
         }
         Ok(if stop { StepControl::Stop } else { StepControl::Continue })
     }

@@ -349,6 +349,10 @@ struct RunArgs {
     /// Continue from the run directory's checkpoint.bin.
     #[arg(long)]
     resume: bool,
+    /// With --resume: the job's [newton] settings may differ from the checkpoint's (the steps
+    /// to come are solved with the job's; e.g. more iterations for a run that stalled).
+    #[arg(long, requires = "resume")]
+    newton_changed: bool,
 }
 
 #[derive(Subcommand)]
@@ -644,7 +648,7 @@ fn run(args: RunArgs) -> Result<()> {
     let checkpoint = if args.resume {
         let path = dir.join(checkpoint::FILE);
         let c = Checkpoint::read(&path)?;
-        c.check_job(&job, &path)?;
+        c.check_job(&job, &path, args.newton_changed)?;
         tracing::info!(step = c.solver.step, "resuming from {}", path.display());
         Some(c)
     } else {

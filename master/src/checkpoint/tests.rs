@@ -91,11 +91,15 @@ impl StepObserver for StopAt<'_> {
 }
 
 fn run(dir: &Path, job: &Job, stop_at: u64, resume: bool) -> Result<()> {
+    run_with(dir, job, stop_at, resume, false)
+}
+
+fn run_with(dir: &Path, job: &Job, stop_at: u64, resume: bool, newton_changed: bool) -> Result<()> {
     let mut solver = Solver::new(job.model()?, job.solver_settings()?)?;
     let ids = ids(&solver);
     let (mut writer, mut material) = if resume {
         let c = Checkpoint::read(&dir.join(FILE))?;
-        c.check_job(job, dir)?;
+        c.check_job(job, dir, newton_changed)?;
         let states = c.assembly_states();
         let step = c.solver.step;
         solver.restore(c.solver)?;
@@ -129,6 +133,45 @@ fn stopped_and_resumed_run_is_bit_identical() {
     // A changed job is refused.
     let other = Job::from_toml(&JOB.replace("0.008", "0.009"), "other").unwrap();
     let c = Checkpoint::read(&resumed.join(FILE)).unwrap();
-    assert!(c.check_job(&other, &resumed).unwrap_err().to_string().contains("another job"));
+    assert!(c.check_job(&other, &resumed, true).unwrap_err().to_string().contains("another job"));
+    std::fs::remove_dir_all(&base).unwrap();
+}
+
+/// A resume with changed `[newton]` settings is refused unless asked for; asked for, the steps
+/// done stay as they were and the steps to come are solved with the new settings: here the
+/// force tolerance tightened by 10^3, so they take more iterations than the straight run's.
+#[test]
+fn a_resume_may_change_the_newton_settings_when_asked() {
+    let job = Job::from_toml(JOB, "small").unwrap();
+    let tight = Job::from_toml(
+        &JOB.replace("force_tolerance = 5.0e-3", "force_tolerance = 5.0e-6"),
+        "tight",
+    )
+    .unwrap();
+    assert_eq!(job_digest(&job), job_digest(&tight), "newton is not the physics digest's");
+    let base = std::env::temp_dir().join(format!("cosdem-ckpt-newton-{}", std::process::id()));
+    let (straight, resumed) = (base.join("straight"), base.join("resumed"));
+    run(&straight, &job, u64::MAX, false).unwrap();
+    let e = run(&resumed, &job, 2, false).unwrap_err();
+    assert!(matches!(e, Error::Interrupted { step: 2 }), "{e}");
+    let refused = run(&resumed, &tight, u64::MAX, true).unwrap_err().to_string();
+    assert!(refused.contains("[newton]") && refused.contains("--newton-changed"), "{refused}");
+    run_with(&resumed, &tight, u64::MAX, true, true).unwrap();
+    let rows = |d: &Path| -> Vec<String> {
+        std::fs::read_to_string(d.join("curve.csv")).unwrap().lines().map(String::from).collect()
+    };
+    let (a, b) = (rows(&straight), rows(&resumed));
+    assert_eq!(a.len(), b.len());
+    assert_eq!(a[..3], b[..3], "the header and the two steps done before the stop are kept");
+    // curve.csv's fifth column: the step's Newton iterations.
+    let iterations = |d: &Path| -> u64 {
+        rows(d)[3..].iter().map(|r| r.split(',').nth(4).unwrap().parse::<u64>().unwrap()).sum()
+    };
+    assert!(
+        iterations(&resumed) > iterations(&straight),
+        "steps 3 and 4 under the tighter tolerance iterate more: {} vs {}",
+        iterations(&resumed),
+        iterations(&straight)
+    );
     std::fs::remove_dir_all(&base).unwrap();
 }
