@@ -124,8 +124,8 @@ impl Checkpoint {
         if bytes.len() >= MAGIC_1.len() && &bytes[..MAGIC_1.len()] == MAGIC_1 {
             return Err(bad(
                 path,
-                "a checkpoint of the first format (CDEMCKP1, cosdem before 2026-12-03): resume \
-                 it with the cosdem that wrote it"
+                "a checkpoint of the first format (CDEMCKP1, a cosdem without --newton-changed): \
+                 resume it with the cosdem that wrote it"
                     .into(),
             ));
         }

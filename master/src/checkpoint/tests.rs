@@ -175,3 +175,18 @@ fn a_resume_may_change_the_newton_settings_when_asked() {
     );
     std::fs::remove_dir_all(&base).unwrap();
 }
+
+/// A file of the first format, or none of ours, is refused with an error that says which.
+#[test]
+fn old_and_foreign_files_are_refused_by_name() {
+    let dir = std::env::temp_dir().join(format!("cosdem-ckpt-format-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(FILE);
+    std::fs::write(&path, b"CDEMCKP1 and whatever followed").unwrap();
+    let old = Checkpoint::read(&path).unwrap_err().to_string();
+    assert!(old.contains("first format") && old.contains("CDEMCKP1"), "{old}");
+    std::fs::write(&path, b"PK\x03\x04 a zip file").unwrap();
+    let foreign = Checkpoint::read(&path).unwrap_err().to_string();
+    assert!(foreign.contains("not a cosdem checkpoint"), "{foreign}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
