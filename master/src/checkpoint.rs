@@ -54,10 +54,8 @@ pub struct SavedAssembly {
 /// Everything needed to continue a run.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Checkpoint {
-    /// Digest of the job's physics ([`job_digest`]).
-    pub job_digest: u64,
-    /// Digest of the job's Newton settings ([`newton_digest`]).
-    pub newton_digest: u64,
+    /// Digests of the job's physics and of its Newton settings.
+    pub digests: Digests,
     /// The solver's state.
     pub solver: SolverState,
     /// The material's committed states (empty for stateless materials).
@@ -88,12 +86,7 @@ impl Checkpoint {
                 state: s.state,
             })
             .collect();
-        Ok(Self {
-            job_digest: digests.job,
-            newton_digest: digests.newton,
-            solver: solver.state(),
-            assemblies,
-        })
+        Ok(Self { digests, solver: solver.state(), assemblies })
     }
 
     /// The material's committed states, for [`Material::restore_states`].
@@ -121,7 +114,7 @@ impl Checkpoint {
     /// Reads a checkpoint written by [`Checkpoint::write`].
     pub fn read(path: &Path) -> Result<Self> {
         let bytes = std::fs::read(path).map_err(|e| bad(path, e.to_string()))?;
-        if bytes.len() >= MAGIC_1.len() && &bytes[..MAGIC_1.len()] == MAGIC_1 {
+        if bytes.starts_with(MAGIC_1) {
             return Err(bad(
                 path,
                 "a checkpoint of the first format (CDEMCKP1, a cosdem without --newton-changed): \
@@ -129,7 +122,7 @@ impl Checkpoint {
                     .into(),
             ));
         }
-        if bytes.len() < MAGIC.len() || &bytes[..MAGIC.len()] != MAGIC {
+        if !bytes.starts_with(MAGIC) {
             return Err(bad(path, "not a cosdem checkpoint (no CDEMCKP2 header)".into()));
         }
         let (c, used): (Self, usize) =
@@ -146,19 +139,18 @@ impl Checkpoint {
     /// `newton_changed`: the job's `[newton]` settings may differ from the checkpoint's (the
     /// steps to come are solved with the job's; a warning is logged).
     pub fn check_job(&self, job: &Job, path: &Path, newton_changed: bool) -> Result<()> {
-        let d = job_digest(job);
-        if d != self.job_digest {
+        let Digests { job: d, newton: n } = Digests::of(job);
+        if d != self.digests.job {
             return Err(bad(
                 path,
                 format!(
                     "the checkpoint was written for another job (digest {:016x}, this job {d:016x}): \
                      mesh, loading or material changed",
-                    self.job_digest
+                    self.digests.job
                 ),
             ));
         }
-        let n = newton_digest(job);
-        if n != self.newton_digest {
+        if n != self.digests.newton {
             if !newton_changed {
                 return Err(bad(
                     path,
@@ -166,7 +158,7 @@ impl Checkpoint {
                         "the checkpoint was written with other [newton] settings (digest \
                          {:016x}, this job {n:016x}); resume with --newton-changed to solve the \
                          steps to come with this job's",
-                        self.newton_digest
+                        self.digests.newton
                     ),
                 ));
             }
@@ -181,7 +173,7 @@ impl Checkpoint {
 }
 
 /// The digests a checkpoint stores.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Digests {
     /// [`job_digest`].
     pub job: u64,
