@@ -324,6 +324,9 @@ pub struct NewtonSection {
     /// Gauss-point secant updates of the iteration matrix within a step (see
     /// `SolverSettings::secant_updates`).
     pub secant_updates: bool,
+    /// Iterations without a new smallest residual that end an attempt early (0 = off; see
+    /// `SolverSettings::stall_iterations`).
+    pub stall_iterations: u32,
 }
 
 impl Default for NewtonSection {
@@ -337,6 +340,7 @@ impl Default for NewtonSection {
             min_increment_fraction: s.min_increment_fraction,
             tolerated_residual: s.tolerated_residual,
             secant_updates: s.secant_updates,
+            stall_iterations: s.stall_iterations,
         }
     }
 }
@@ -724,6 +728,7 @@ impl Job {
             min_increment_fraction: n.min_increment_fraction,
             tolerated_residual: n.tolerated_residual,
             secant_updates: n.secant_updates,
+            stall_iterations: n.stall_iterations,
             ..SolverSettings::default()
         })
     }

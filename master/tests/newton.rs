@@ -191,9 +191,14 @@ fn cholesky_and_lu_paths_agree() {
 /// Elastic stresses, the tangent scaled by 0.4, and 7 DEM steps reported per Gauss point
 /// per evaluation (summed into `count`: what the solver was asked to relax).
 fn soft_tangent(count: &mut u64) -> impl Material + '_ {
+    scaled_tangent(0.4, count)
+}
+
+/// Elastic stresses with the tangent scaled by `factor`; 7 DEM steps per answer, counted.
+fn scaled_tangent(factor: f64, count: &mut u64) -> impl Material + '_ {
     Adjusted(elastic(), move |_: TrialId, _: &[MaterialInput], r: &mut [MicroResponse]| {
         for x in r.iter_mut() {
-            x.tangent = x.tangent.map(|row| row.map(|v| 0.4 * v));
+            x.tangent = x.tangent.map(|row| row.map(|v| factor * v));
             x.diagnostics.steps = 7;
         }
         *count += 7 * r.len() as u64;
@@ -232,6 +237,155 @@ fn line_search_engages_when_the_residual_grows() {
     assert!(s.line_search_halvings > 0 && s.cuts == 0);
     // the top reaction balances the pressure: 1e5 Pa on 1 m
     assert!((log[0].reactions["bottom"][1] - 1e5).abs() < 1e-6 * 1e5, "{:?}", log[0].reactions);
+}
+
+/// The displacement criterion measures the full Newton correction, not the part the line
+/// search let through. The tangent here is a tenth of the elastic one, so every full update
+/// overshoots 10 times; three halvings (alpha = 1/8) give 1.25 times the exact correction,
+/// and the error contracts by -0.25 per iteration. With the force criterion off the step can
+/// only end on `|du| <= t |u - u_n|`, t = 0.05. Measured on the full correction (10 times
+/// the exact one, e) that means |e| <= t / 10 of the step, and after the damped update the
+/// error is 0.25 |e| <= 0.125 % of the step; measured on the damped update (1.25 e) it
+/// would mean |e| <= t / 1.25 and an error of up to 1 % of the step. Measured: 0.055 % of
+/// the step after 8 iterations; the damped measure ended the step after 6, at 0.88 %.
+/// Checked: the accepted displacement is within 0.2 % of the step of the exact elastic
+/// answer (a linear problem: the exact answer is one elastic solve, tolerance 1e-12), and
+/// the step backtracked.
+#[test]
+fn a_line_search_damped_update_cannot_end_a_step() {
+    let settings = SolverSettings {
+        steps: 1,
+        max_iterations: 60,
+        force_tolerance: 0.0,
+        displacement_tolerance: 0.05,
+        ..Default::default()
+    };
+    let mut solver = Solver::new(top_pressure_panel(), settings).unwrap();
+    let mut log: Vec<StepReport> = Vec::new();
+    solver.run(&mut scaled_tangent(0.1, &mut 0), &mut log).unwrap();
+    let mut exact = Solver::new(
+        top_pressure_panel(),
+        SolverSettings { steps: 1, force_tolerance: 1e-12, ..Default::default() },
+    )
+    .unwrap();
+    exact.run(&mut elastic(), &mut ()).unwrap();
+    let (u, v) = (solver.solution().dofs, exact.solution().dofs);
+    let error = u.iter().zip(v).map(|(a, b)| (a - b) * (a - b)).sum::<f64>().sqrt();
+    let step = v.iter().map(|b| b * b).sum::<f64>().sqrt();
+    let s = &log[0];
+    println!(
+        "halvings {} iterations {} residuals {:?}; error {:.3e} of the step",
+        s.line_search_halvings,
+        s.iterations,
+        sci(&s.residuals),
+        error / step
+    );
+    assert!(s.line_search_halvings >= 3 && s.cuts == 0, "{s:?}");
+    assert!(error <= 2e-3 * step, "error {error:e} of a step of {step:e}");
+}
+
+/// A tolerated step accepts the best iterate of the attempt, not the last. Without line
+/// search, a tangent of 0.4 times the elastic one makes every full update overshoot 2.5
+/// times: the error goes x -> -1.5 x per iteration and the iterates grow worse (printed
+/// residuals). With two iterations allowed and `tolerated_residual` between the first
+/// iterate's residual and the others', the step is tolerated at the first iterate (the
+/// predictor, 2.5 times the exact elastic displacement: a linear problem, so up to
+/// rounding, 1e-9), evaluated again, with the first iterate's residual as its last (the
+/// material answers from its committed state: the same answer, to the last bit).
+#[test]
+fn a_tolerated_step_accepts_its_best_iterate() {
+    let residuals_of = |tolerated_residual: f64| {
+        let settings = SolverSettings {
+            steps: 1,
+            max_iterations: 2,
+            line_search: false,
+            min_increment_fraction: 1.0,
+            tolerated_residual,
+            ..Default::default()
+        };
+        let mut solver = Solver::new(top_pressure_panel(), settings).unwrap();
+        let mut log: Vec<StepReport> = Vec::new();
+        let result = solver.run(&mut scaled_tangent(0.4, &mut 0), &mut log);
+        (result.map(|_| ()), log, solver.solution().dofs.to_vec())
+    };
+    // Off: the attempt fails; its residuals are in the error.
+    let (failed, _, _) = residuals_of(0.0);
+    println!("{}", failed.as_ref().unwrap_err());
+    assert!(matches!(failed, Err(Error::StepTooSmall { .. })));
+    // Probe the residuals with everything tolerated (the best is accepted, whichever).
+    let (_, log, _) = residuals_of(10.0);
+    let r = log[0].residuals.clone();
+    println!("residuals {:?}", sci(&r));
+    assert!(r.len() == 4 && r[0] < r[1].min(r[2]), "{r:?}");
+    assert_eq!(r[3].to_bits(), r[0].to_bits(), "the re-evaluated best iterate");
+    // Tolerated between the first and the last: the first iterate is accepted.
+    let (ok, log, u) = residuals_of(0.5 * (r[0] + r[1].min(r[2])));
+    ok.unwrap();
+    assert!(log[0].tolerated && log[0].residuals.last() == Some(&r[0]), "{:?}", log[0]);
+    let mut exact = Solver::new(
+        top_pressure_panel(),
+        SolverSettings { steps: 1, force_tolerance: 1e-12, ..Default::default() },
+    )
+    .unwrap();
+    exact.run(&mut elastic(), &mut ()).unwrap();
+    let v = exact.solution().dofs;
+    let size = v.iter().fold(0.0f64, |m, b| m.max(b.abs()));
+    for (a, b) in u.iter().zip(v) {
+        assert!((a - 2.5 * b).abs() <= 1e-9 * size, "{a} vs 2.5 x {b}");
+    }
+}
+
+/// `stall_iterations`: an attempt whose smallest residual is within `tolerated_residual`
+/// and has not fallen for that many iterations ends there, tolerated. On the diverging
+/// iteration of [`a_tolerated_step_accepts_its_best_iterate`] (residuals 0.43, 1.29, 0.55,
+/// ..., none below the first), a limit of 2 ends the attempt at iteration 3 and tolerates
+/// the first iterate, where without it the attempt runs to its 20 iterations; with the
+/// tolerated residual below the first iterate's, the stall does not end it early (it runs
+/// to 20 iterations and fails). On the contracting
+/// iteration of [`newton_converges_quadratically_with_exact_tangent`] every iteration is a
+/// new best, so even a limit of 1 changes nothing (the same dofs, bit for bit).
+#[test]
+fn a_stalled_attempt_ends_early_a_contracting_one_does_not() {
+    let diverging = |stall_iterations: u32, tolerated_residual: f64| {
+        let settings = SolverSettings {
+            steps: 1,
+            max_iterations: 20,
+            line_search: false,
+            min_increment_fraction: 1.0,
+            tolerated_residual,
+            stall_iterations,
+            ..Default::default()
+        };
+        let mut solver = Solver::new(top_pressure_panel(), settings).unwrap();
+        let mut log: Vec<StepReport> = Vec::new();
+        let result = solver.run(&mut scaled_tangent(0.4, &mut 0), &mut log);
+        (result.map(|_| ()), log)
+    };
+    let (off, on) = (diverging(0, 10.0).1.remove(0), diverging(2, 10.0).1.remove(0));
+    println!("off: {} iterations; on: {} iterations", off.iterations, on.iterations);
+    assert_eq!(off.iterations, 21);
+    assert_eq!(on.iterations, 3);
+    assert!(on.tolerated && on.residuals.last() == Some(&on.residuals[0]), "{on:?}");
+    // Tolerated below the best (0.43): no early end, the attempt fails after 20 iterations.
+    match diverging(2, 0.1).0 {
+        Err(Error::StepTooSmall { reason, .. }) => {
+            assert!(reason.contains("20 iterations"), "{reason}");
+        }
+        other => panic!("{other:?}"),
+    }
+
+    let contracting = |stall_iterations: u32| {
+        let settings = SolverSettings {
+            steps: 2,
+            force_tolerance: 1e-13,
+            stall_iterations,
+            ..Default::default()
+        };
+        let mut solver = Solver::new(panel(-0.04), settings).unwrap();
+        solver.run(&mut SofteningElastic { elastic: elastic(), beta: 400.0 }, &mut ()).unwrap();
+        solver.solution().dofs.iter().map(|x| x.to_bits()).collect::<Vec<_>>()
+    };
+    assert_eq!(contracting(0), contracting(1));
 }
 
 /// Smooth platens on an elastic panel give the homogeneous uniaxial plane-strain state:
