@@ -234,6 +234,28 @@ impl Failure {
 /// One evaluation of the material: the answers and the kinematics they answer.
 type Evaluation = (Vec<MicroResponse>, Vec<MaterialInput>);
 
+/// One evaluated iterate: the answers, the kinematics they answer, the assembled system and
+/// the residual on the free dofs with its force scale.
+struct Trial {
+    responses: Vec<MicroResponse>,
+    inputs: Vec<MaterialInput>,
+    asm: Assembled,
+    r: Vec<f64>,
+    scale: f64,
+}
+
+impl Trial {
+    /// The relative residual `|r| / scale` of a residual norm (0 without a force scale).
+    fn relative_of(norm: f64, scale: f64) -> f64 {
+        if scale > 0.0 { norm / scale } else { 0.0 }
+    }
+
+    /// This iterate's relative residual.
+    fn relative(&self) -> f64 {
+        Self::relative_of(norm(&self.r), self.scale)
+    }
+}
+
 enum Attempt {
     Converged { iterations: u32, residuals: Vec<f64>, halvings: u32, tolerated: bool },
     Failed(Failure),
@@ -589,6 +611,23 @@ impl Solver {
         (r, scale)
     }
 
+    /// Evaluates the material at `u` and assembles residual and matrix there.
+    fn trial(
+        &mut self,
+        material: &mut dyn Material,
+        trial: TrialId,
+        u: &[f64],
+        f_ext: &[f64],
+    ) -> Result<std::result::Result<Trial, Failure>> {
+        let (responses, inputs) = match self.evaluate(material, trial, u)? {
+            Ok(e) => e,
+            Err(f) => return Ok(Err(f)),
+        };
+        let asm = self.assemble(&responses, None);
+        let (r, scale) = self.residual(&asm.f_int, f_ext);
+        Ok(Ok(Trial { responses, inputs, asm, r, scale }))
+    }
+
     /// One attempt at reaching load factor `target` from the converged state.
     fn attempt(
         &mut self,
@@ -660,20 +699,17 @@ impl Solver {
             let span = tracing::info_span!("newton", iteration = k);
             let _enter = span.enter();
             let mut alpha = 1.0;
-            let (responses, inputs, asm, r, scale) = loop {
-                let (responses, inputs) =
-                    match self.evaluate(material, next_trial(iteration), &u)? {
-                        Ok(r) => r,
-                        Err(f) => return Ok(Attempt::Failed(f)),
-                    };
-                let asm = self.assemble(&responses, None);
-                let (r, scale) = self.residual(&asm.f_int, &f_ext);
-                let grows = previous.as_ref().is_some_and(|(_, rp)| norm(&r) > *rp);
+            let Trial { responses, inputs, asm, r, scale } = loop {
+                let trial = match self.trial(material, next_trial(iteration), &u, &f_ext)? {
+                    Ok(t) => t,
+                    Err(f) => return Ok(Attempt::Failed(f)),
+                };
+                let grows = previous.as_ref().is_some_and(|(_, rp)| norm(&trial.r) > *rp);
                 let can_cut = self.settings.line_search
                     && grows
                     && alpha > 0.5f64.powi(self.settings.max_line_search as i32);
                 if !can_cut {
-                    break (responses, inputs, asm, r, scale);
+                    break trial;
                 }
                 alpha *= 0.5;
                 halvings += 1;
@@ -686,7 +722,7 @@ impl Solver {
             if !rn.is_finite() {
                 return Ok(Attempt::Failed(Failure::Singular("residual not finite".into())));
             }
-            let rel = if scale > 0.0 { rn / scale } else { 0.0 };
+            let rel = Trial::relative_of(rn, scale);
             residuals.push(rel);
             last_rel = rel;
             let step_norm: f64 =
@@ -702,8 +738,7 @@ impl Solver {
             let by_displacement =
                 k > 1 && du_norm <= self.settings.displacement_tolerance * step_norm;
             if by_force || by_displacement {
-                self.accept(u, &inputs, &responses, &asm.f_int, &f_ext);
-                self.committed = Some(responses);
+                self.accept(u, &inputs, responses, &asm.f_int, &f_ext);
                 return Ok(Attempt::Converged {
                     iterations: k,
                     residuals,
@@ -727,40 +762,32 @@ impl Solver {
                 if best_rel > self.settings.tolerated_residual {
                     break;
                 }
-                if best_rel == rel {
-                    self.accept(u, &inputs, &responses, &asm.f_int, &f_ext);
-                    self.committed = Some(responses);
-                    return Ok(Attempt::Converged {
-                        iterations: k,
-                        residuals,
-                        halvings,
-                        tolerated: true,
-                    });
-                }
-                // An earlier iterate was better: the material holds the last trial only, so
-                // the best one is evaluated again (from the committed state: the same answer
-                // unless the material warm-starts) and accepted if it is still tolerated.
-                let (responses, inputs) =
-                    match self.evaluate(material, next_trial(iteration), &best_u)? {
-                        Ok(r) => r,
-                        Err(f) => return Ok(Attempt::Failed(f)),
-                    };
-                let asm = self.assemble(&responses, None);
-                let (r, scale) = self.residual(&asm.f_int, &f_ext);
-                let rel = if scale > 0.0 { norm(&r) / scale } else { 0.0 };
-                last_rel = rel;
-                residuals.push(rel);
-                if rel <= self.settings.tolerated_residual {
-                    self.accept(best_u, &inputs, &responses, &asm.f_int, &f_ext);
-                    self.committed = Some(responses);
-                    return Ok(Attempt::Converged {
-                        iterations: k,
-                        residuals,
-                        halvings,
-                        tolerated: true,
-                    });
-                }
-                break;
+                let (u, trial) = if best_at == k {
+                    (u, Trial { responses, inputs, asm, r, scale })
+                } else {
+                    // An earlier iterate was better: the material holds the last trial only,
+                    // so the best one is evaluated again (from the committed state: the same
+                    // answer unless the material warm-starts) and accepted if it is still
+                    // tolerated.
+                    let trial =
+                        match self.trial(material, next_trial(iteration), &best_u, &f_ext)? {
+                            Ok(t) => t,
+                            Err(f) => return Ok(Attempt::Failed(f)),
+                        };
+                    last_rel = trial.relative();
+                    residuals.push(last_rel);
+                    if last_rel > self.settings.tolerated_residual {
+                        break;
+                    }
+                    (best_u, trial)
+                };
+                self.accept(u, &trial.inputs, trial.responses, &trial.asm.f_int, &f_ext);
+                return Ok(Attempt::Converged {
+                    iterations: k,
+                    residuals,
+                    halvings,
+                    tolerated: true,
+                });
             }
             // An iteration that did not contract ends the secant updates of this attempt: the
             // rest of it iterates with the answers' own tangents (as without the option; the
@@ -800,20 +827,21 @@ impl Solver {
     }
 
     /// Stores the converged state: dofs, Gauss-point states (from the kinematics `inputs` at
-    /// `u` and their answers), reactions.
+    /// `u` and their answers), reactions, and the answers (the next predictor's tangent).
     fn accept(
         &mut self,
         u: Vec<f64>,
         inputs: &[MaterialInput],
-        responses: &[MicroResponse],
+        responses: Vec<MicroResponse>,
         f_int: &[f64],
         f_ext: &[f64],
     ) {
-        for ((s, i), r) in self.states.iter_mut().zip(inputs).zip(responses) {
+        for ((s, i), r) in self.states.iter_mut().zip(inputs).zip(&responses) {
             s.strain = i.deformation.strain();
             s.stress = r.stress;
             s.diagnostics = r.diagnostics.clone();
         }
+        self.committed = Some(responses);
         let ndf = self.dofs.field.ndf();
         self.reactions = self
             .model
