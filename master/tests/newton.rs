@@ -341,9 +341,9 @@ fn a_tolerated_step_accepts_its_best_iterate() {
 /// ..., none below the first), a limit of 2 ends the attempt at iteration 3 and tolerates
 /// the first iterate, where without it the attempt runs to its 20 iterations; with the
 /// tolerated residual below the first iterate's, the stall does not end it early (it runs
-/// to 20 iterations and fails). On the contracting
-/// iteration of [`newton_converges_quadratically_with_exact_tangent`] every iteration is a
-/// new best, so even a limit of 1 changes nothing (the same dofs, bit for bit).
+/// to 20 iterations and fails). On the contracting iteration of
+/// [`newton_converges_quadratically_with_exact_tangent`] every iteration is a new best, so
+/// even a limit of 1 changes nothing (the same dofs, bit for bit).
 #[test]
 fn a_stalled_attempt_ends_early_a_contracting_one_does_not() {
     let diverging = |stall_iterations: u32, tolerated_residual: f64| {
