@@ -324,7 +324,8 @@ pub struct NewtonSection {
     /// Gauss-point secant updates of the iteration matrix within a step (see
     /// `SolverSettings::secant_updates`).
     pub secant_updates: bool,
-    /// Iterations without a new smallest residual that end an attempt early (0 = off; see
+    /// Iterations without a new smallest residual after which an attempt whose best is
+    /// already within `tolerated_residual` is accepted there (0 = off; see
     /// `SolverSettings::stall_iterations`).
     pub stall_iterations: u32,
 }
