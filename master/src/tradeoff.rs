@@ -317,7 +317,8 @@ fn knob_moves(base: &Job) -> Vec<Variant> {
     if !base.newton.secant_updates {
         v.push(with(base, "newton.secant_updates", "true", |j| j.newton.secant_updates = true));
     }
-    // An attempt ends after this many iterations without a new smallest residual.
+    // An attempt whose best residual is tolerated ends after this many iterations without a
+    // new smallest one.
     if base.newton.stall_iterations == 0 {
         v.push(with(base, "newton.stall_iterations", STALL, |j| {
             j.newton.stall_iterations = STALL;

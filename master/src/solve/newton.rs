@@ -746,22 +746,21 @@ impl Solver {
                     tolerated: false,
                 });
             }
-            if best.as_ref().is_none_or(|(b, _)| rel < *b) {
+            // Only a tolerated step uses the best iterate: without one, no copy of `u`.
+            let tolerating = self.settings.tolerated_residual > 0.0;
+            if tolerating && best.as_ref().is_none_or(|(b, _)| rel < *b) {
                 best = Some((rel, u.clone()));
                 best_at = k;
             }
+            let tolerated =
+                best.as_ref().is_some_and(|(b, _)| *b <= self.settings.tolerated_residual);
             let stall = self.settings.stall_iterations;
-            let stalled = stall > 0
-                && k - best_at >= stall
-                && best.as_ref().is_some_and(|(b, _)| *b <= self.settings.tolerated_residual);
+            let stalled = stall > 0 && tolerated && k - best_at >= stall;
             if stalled {
                 tracing::debug!(iterations = k, since = best_at, "stalled");
             }
             if k > self.settings.max_iterations || stalled {
-                let Some((best_rel, best_u)) = best.take() else { break };
-                if best_rel > self.settings.tolerated_residual {
-                    break;
-                }
+                let Some((_, best_u)) = best.take().filter(|_| tolerated) else { break };
                 let (u, trial) = if best_at == k {
                     (u, Trial { responses, inputs, asm, r, scale })
                 } else {
