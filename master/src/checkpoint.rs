@@ -145,7 +145,8 @@ impl Checkpoint {
                 path,
                 format!(
                     "the checkpoint was written for another job (digest {:016x}, this job {d:016x}): \
-                     mesh, loading or material changed",
+                     mesh, loading or material changed, or a cosdem whose job format has other \
+                     fields or defaults wrote it",
                     self.digests.job
                 ),
             ));
@@ -156,8 +157,9 @@ impl Checkpoint {
                     path,
                     format!(
                         "the checkpoint was written with other [newton] settings (digest \
-                         {:016x}, this job {n:016x}); resume with --newton-changed to solve the \
-                         steps to come with this job's",
+                         {:016x}, this job {n:016x}): the job's [newton] changed, or a cosdem \
+                         whose [newton] has other fields or defaults wrote it; resume with \
+                         --newton-changed to solve the steps to come with this job's",
                         self.digests.newton
                     ),
                 ));

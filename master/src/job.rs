@@ -328,6 +328,10 @@ pub struct NewtonSection {
     /// already within `tolerated_residual` is accepted there (0 = off; see
     /// `SolverSettings::stall_iterations`).
     pub stall_iterations: u32,
+    /// Relative force residual up to which the attempt at the smallest increment accepts its
+    /// best iterate instead of ending the run, as a "forced" step (0 = never; see
+    /// `SolverSettings::forced_residual`).
+    pub forced_residual: f64,
 }
 
 impl Default for NewtonSection {
@@ -342,6 +346,7 @@ impl Default for NewtonSection {
             tolerated_residual: s.tolerated_residual,
             secant_updates: s.secant_updates,
             stall_iterations: s.stall_iterations,
+            forced_residual: s.forced_residual,
         }
     }
 }
@@ -560,6 +565,7 @@ impl Job {
             ("newton.force_tolerance", n.force_tolerance),
             ("newton.displacement_tolerance", n.displacement_tolerance),
             ("newton.tolerated_residual", n.tolerated_residual),
+            ("newton.forced_residual", n.forced_residual),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(bad(name, v, "must be finite and >= 0"));
@@ -730,6 +736,7 @@ impl Job {
             tolerated_residual: n.tolerated_residual,
             secant_updates: n.secant_updates,
             stall_iterations: n.stall_iterations,
+            forced_residual: n.forced_residual,
             ..SolverSettings::default()
         })
     }

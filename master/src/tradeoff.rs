@@ -730,12 +730,17 @@ pub const PARETO_FILE: &str = "pareto.png";
 /// those targets pick: the measured check of the prediction) and `cheapest` (every knob at
 /// its cheapest candidate setting, whatever the predicted error: where the knobs end). A
 /// combination that moves no knob, or the same knobs as an earlier one, is not run again.
+///
+/// With `resume`, a variant whose run directory already holds a run of the same job that
+/// ended (see [`ended_run`]) is read back instead of run again: an interrupted sweep goes on
+/// where it stopped, and the rows it had keep the wall times measured then.
 pub fn sweep(
     base: &Job,
     title: &str,
     out: &std::path::Path,
     workers: &crate::run::WorkerChoice,
     skip: &[String],
+    resume: bool,
     mut progress: impl FnMut(&Row),
 ) -> Result<Vec<Row>, crate::run::RunError> {
     let mut base = base.clone();
@@ -748,7 +753,7 @@ pub fn sweep(
     let mut rows: Vec<Row> = Vec::new();
     let mut reference: Option<Reference> = None;
     for v in &variants {
-        let row = run_variant(v, out, workers, &mut reference)?;
+        let row = run_variant(v, out, workers, resume, &mut reference)?;
         progress(&row);
         rows.push(row);
         write_tables(&rows, title, out)?;
@@ -757,7 +762,7 @@ pub fn sweep(
         if skipped(&v, skip) {
             continue;
         }
-        let row = run_variant(&v, out, workers, &mut reference)?;
+        let row = run_variant(&v, out, workers, resume, &mut reference)?;
         progress(&row);
         rows.push(row);
         write_tables(&rows, title, out)?;
@@ -768,16 +773,58 @@ pub fn sweep(
 /// The reference's metrics, curve and wall time (the sweep's first run).
 pub(crate) type Reference = (CurveMetrics, Vec<(f64, f64)>, f64);
 
-/// Runs one variant into `out/runs/<slug>` and compares it with the reference (the first
-/// run becomes the reference).
+/// The file beside each of a sweep's runs that names the job it ran (the variant's whole job
+/// as JSON): what `resume` checks before it reuses the run.
+pub const VARIANT_FILE: &str = "variant.json";
+
+/// The run in `dir`, if it is a run of `job` that ended: [`VARIANT_FILE`] holds this very
+/// job, `summary.json` says `finished` or `failed: ...` (both are the job's deterministic
+/// outcome), and `curve.csv` has one row per step the summary counts. A run that was still
+/// going or was interrupted, a run of another job (another setting, another scene, a
+/// directory of another sweep), or a directory that cannot be read gives `None`: the variant
+/// is run again. The solver itself is not checked: the runs must come from the same cosdem.
+pub fn ended_run(
+    dir: &std::path::Path,
+    job: &Job,
+) -> Option<(crate::output::run_dir::Summary, Vec<(f64, f64)>)> {
+    let recorded = std::fs::read_to_string(dir.join(VARIANT_FILE)).ok()?;
+    if recorded != serde_json::to_string_pretty(job).ok()? {
+        return None;
+    }
+    let text = std::fs::read_to_string(dir.join("summary.json")).ok()?;
+    let summary: crate::output::run_dir::Summary = serde_json::from_str(&text).ok()?;
+    let ended = summary.status == "finished" || summary.status.starts_with("failed");
+    let curve = crate::output::plot::curve::read_curve(&dir.join("curve.csv")).ok()?;
+    (ended && curve.len() as u64 == summary.steps).then_some((summary, curve))
+}
+
+/// Runs one variant into `out/runs/<slug>` (or, with `resume`, reads the run that is there
+/// if it is this variant's and ended) and compares it with the reference (the first row
+/// becomes the reference).
 fn run_variant(
     v: &Variant,
     out: &std::path::Path,
     workers: &crate::run::WorkerChoice,
+    resume: bool,
     reference: &mut Option<Reference>,
 ) -> Result<Row, crate::run::RunError> {
     let dir = out.join("runs").join(v.slug());
-    let (summary, curve) = crate::run::run_job(&v.job, &dir, workers)?;
+    let (summary, curve) = match resume.then(|| ended_run(&dir, &v.job)).flatten() {
+        Some(ended) => {
+            tracing::info!(run = %dir.display(), status = %ended.0.status, "reused");
+            ended
+        }
+        None => {
+            std::fs::create_dir_all(&dir).map_err(|source| crate::output::OutputError::Io {
+                path: dir.clone(),
+                action: "create directory",
+                source,
+            })?;
+            let json = serde_json::to_string_pretty(&v.job)?;
+            crate::output::write_atomic(&dir.join(VARIANT_FILE), json.as_bytes())?;
+            crate::run::run_job(&v.job, &dir, workers)?
+        }
+    };
     let (rm, rc, rt) =
         reference.get_or_insert_with(|| (summary.metrics, curve.clone(), summary.wall_seconds));
     Ok(Row {
@@ -1233,6 +1280,65 @@ mod tests {
         let elastic =
             Job::from_toml(include_str!("../../examples/elastic.toml"), "elastic").unwrap();
         assert!(combinations(&elastic, &rows).unwrap().is_empty());
+    }
+
+    /// `--resume` goes on with a stopped sweep: the runs that ended are read back (a wall
+    /// time planted in one proves it was read, not run), and a run that was interrupted, a
+    /// run of another job and a missing run are run again, so every row ends as it did in the
+    /// uninterrupted sweep. The elastic panel: its seven rows take milliseconds.
+    #[test]
+    fn a_resumed_sweep_reads_the_ended_runs_and_runs_the_rest() {
+        let out = std::env::temp_dir().join(format!("cosdem-resume-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&out);
+        let job = Job::from_toml(include_str!("../../examples/elastic.toml"), "elastic").unwrap();
+        let workers = crate::run::WorkerChoice::default();
+        let first = sweep(&job, "t", &out, &workers, &[], false, |_| {}).unwrap();
+        // An analytical material has no combinations: every row is one of the variants.
+        let jobs: Vec<Job> = first
+            .iter()
+            .map(|r| {
+                let s = slug(&r.knob, &r.setting);
+                variants(&job).into_iter().find(|v| v.slug() == s).unwrap().job
+            })
+            .collect();
+        assert!(jobs.len() >= 5, "{} rows", jobs.len());
+        let run = |i: usize| out.join("runs").join(slug(&first[i].knob, &first[i].setting));
+        let set = |i: usize, key: &str, value: serde_json::Value| {
+            let path = run(i).join("summary.json");
+            let mut s: serde_json::Value =
+                serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+            s[key] = value;
+            std::fs::write(&path, serde_json::to_string_pretty(&s).unwrap()).unwrap();
+        };
+        // The reference ended: plant a wall time that no run measures.
+        set(0, "wall_seconds", 1234.5.into());
+        // Row 2 was interrupted, row 3 holds a run of another job (row 4's), row 4 never
+        // started.
+        set(2, "status", "interrupted".into());
+        std::fs::copy(run(4).join(VARIANT_FILE), run(3).join(VARIANT_FILE)).unwrap();
+        std::fs::remove_dir_all(run(4)).unwrap();
+        assert!(ended_run(&run(0), &job).is_none(), "the reference's run is not the job's");
+        assert!(ended_run(&run(2), &jobs[2]).is_none(), "an interrupted run is no result");
+        assert!(ended_run(&run(3), &jobs[3]).is_none(), "row 3 holds another job's run");
+        let mut heard = 0;
+        let second = sweep(&job, "t", &out, &workers, &[], true, |_| heard += 1).unwrap();
+        assert_eq!(heard, first.len());
+        assert_eq!(second[0].wall_seconds, 1234.5, "the reference was run again");
+        assert_eq!(second[1].wall_seconds, first[1].wall_seconds, "the default was run again");
+        for (i, (a, b)) in first.iter().zip(&second).enumerate() {
+            assert_eq!((&a.knob, &a.setting, &a.status), (&b.knob, &b.setting, &b.status));
+            assert_eq!(
+                (a.metrics, a.dem_steps, a.cuts),
+                (b.metrics, b.dem_steps, b.cuts),
+                "row {i}"
+            );
+            // Every speedup is against the reference's planted wall time now.
+            assert_eq!(b.speedup, 1234.5 / b.wall_seconds, "row {i}");
+            assert_eq!(a.errors, b.errors, "row {i}");
+            // Every row's directory holds its own job's ended run, the re-run ones included.
+            assert!(ended_run(&run(i), &jobs[i]).is_some(), "row {i}");
+        }
+        std::fs::remove_dir_all(&out).unwrap();
     }
 
     fn assembly_of(job: &Job) -> Option<&cosdem_worker::AssemblySpec> {

@@ -96,6 +96,7 @@ const KEYS: &[&str] = &[
     "tolerated_residual",
     "secant_updates",
     "stall_iterations",
+    "forced_residual",
     "output",
     "dir",
     "vtk_every",

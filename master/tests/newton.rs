@@ -335,6 +335,69 @@ fn a_tolerated_step_accepts_its_best_iterate() {
     }
 }
 
+/// `forced_residual`: only the attempt at the smallest increment (one more halving would end
+/// the run) accepts its best iterate above `tolerated_residual`, up to the forced residual,
+/// as a forced step. The diverging iteration of [`a_tolerated_step_accepts_its_best_iterate`]
+/// (a linear problem: from the unloaded state every increment gives the same relative
+/// residuals, the first iterate's the best) with the tolerated residual below every
+/// iterate's: without the forced residual, or with one below the best iterate's, the run
+/// ends; with one between the best and the others, the full step and the half step are cut
+/// as before, and the quarter step (the smallest) is forced at its first iterate; the run
+/// then goes on to its end. Where the tolerated residual already accepts, a forced residual
+/// changes nothing, bit for bit.
+#[test]
+fn the_smallest_increment_is_forced_through_up_to_the_forced_residual() {
+    let run = |tolerated_residual: f64, forced_residual: f64| {
+        let settings = SolverSettings {
+            steps: 1,
+            max_iterations: 2,
+            line_search: false,
+            min_increment_fraction: 0.25,
+            tolerated_residual,
+            forced_residual,
+            ..Default::default()
+        };
+        let mut solver = Solver::new(top_pressure_panel(), settings).unwrap();
+        let mut log: Vec<StepReport> = Vec::new();
+        let result = solver.run(&mut scaled_tangent(0.4, &mut 0), &mut log);
+        (result.map(|_| ()), log, solver.solution().dofs.to_vec())
+    };
+    // Probe: everything tolerated, the best iterate is the first.
+    let (_, log, u_tolerated) = run(10.0, 0.0);
+    let r = log[0].residuals.clone();
+    assert!(r.len() == 4 && r[0] < r[1].min(r[2]), "{r:?}");
+    assert!(log.iter().all(|s| s.tolerated && !s.forced && s.cuts == 0), "{log:?}");
+    let tolerated = 0.5 * r[0];
+    let forced = 0.5 * (r[0] + r[1].min(r[2]));
+    for off in [0.0, 0.9 * r[0]] {
+        let (ended, log, _) = run(tolerated, off);
+        assert!(matches!(ended, Err(Error::StepTooSmall { .. })), "forced {off}: {ended:?}");
+        assert!(log.is_empty());
+    }
+    let (ok, log, _) = run(tolerated, forced);
+    ok.unwrap();
+    let steps: Vec<_> = log.iter().map(|s| (s.increment, s.cuts, s.forced)).collect();
+    println!("(increment, cuts, forced): {steps:?}");
+    let first = &log[0];
+    assert!(first.tolerated && first.forced && first.increment == 0.25, "{first:?}");
+    assert_eq!(first.cuts, 2, "the full step and the half step were cut");
+    // Its first iterate, as at the full step (a linear problem: the same relative residual
+    // at a quarter of the load, up to rounding).
+    let last = *first.residuals.last().unwrap();
+    assert!((last - r[0]).abs() <= 1e-12 * r[0], "{last} vs {}", r[0]);
+    // The steps after it start loaded, so their residuals relative to the larger forces are
+    // smaller: tolerated at larger increments, none forced.
+    assert!(log[1..].iter().all(|s| s.tolerated && !s.forced), "{log:?}");
+    assert!((log.iter().map(|s| s.increment).sum::<f64>() - 1.0).abs() < 1e-12);
+    // A forced residual changes nothing where the tolerated one already accepts.
+    let (_, log_both, u_both) = run(10.0, 20.0);
+    assert!(log_both.iter().all(|s| !s.forced));
+    assert_eq!(
+        u_both.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+        u_tolerated.iter().map(|x| x.to_bits()).collect::<Vec<_>>()
+    );
+}
+
 /// `stall_iterations`: an attempt whose smallest residual is within `tolerated_residual`
 /// and has not fallen for that many iterations ends there, tolerated. On the diverging
 /// iteration of [`a_tolerated_step_accepts_its_best_iterate`] (residuals 0.43, 1.29, 0.55,

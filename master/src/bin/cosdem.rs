@@ -167,6 +167,12 @@ struct TradeoffArgs {
     /// (`relaxation.driver=fire`), comma-separated (e.g. a setting known to stall the scene).
     #[arg(long, value_delimiter = ',')]
     skip: Vec<String>,
+    /// Go on with an earlier sweep into the same --out: a setting whose run directory holds a
+    /// run of the same job that ended (finished or failed) is read back, with the wall time
+    /// it took then, instead of run again. Interrupted runs and runs of another job are run
+    /// again. The run directories must come from the same cosdem build.
+    #[arg(long)]
+    resume: bool,
 }
 
 fn tradeoff(a: TradeoffArgs) -> Result<()> {
@@ -185,20 +191,21 @@ fn tradeoff(a: TradeoffArgs) -> Result<()> {
     );
     let pct = |e: Option<f64>| e.map_or("-".into(), |e| format!("{:.2}%", 100.0 * e));
     let workers = WorkerChoice::default();
-    let rows = cosdem_master::tradeoff::sweep(&job, &title, &out, &workers, &a.skip, |r| {
-        println!(
-            "{:<26} {:<14} {:>9.1} {:>7.2}x {:>8} {:>8} {:>8} {:>8} {}",
-            r.knob,
-            r.setting,
-            r.wall_seconds,
-            r.speedup,
-            pct(r.errors.peak),
-            pct(r.errors.residual),
-            pct(r.errors.stiffness),
-            pct(r.errors.curve),
-            if r.status == "finished" { String::new() } else { r.status.clone() }
-        );
-    })?;
+    let rows =
+        cosdem_master::tradeoff::sweep(&job, &title, &out, &workers, &a.skip, a.resume, |r| {
+            println!(
+                "{:<26} {:<14} {:>9.1} {:>7.2}x {:>8} {:>8} {:>8} {:>8} {}",
+                r.knob,
+                r.setting,
+                r.wall_seconds,
+                r.speedup,
+                pct(r.errors.peak),
+                pct(r.errors.residual),
+                pct(r.errors.stiffness),
+                pct(r.errors.curve),
+                if r.status == "finished" { String::new() } else { r.status.clone() }
+            );
+        })?;
     println!("{} settings -> {}", rows.len(), out.join("tradeoff.md").display());
     // The sweep redraws the plot after every row and only logs a failure: say it here.
     let png = out.join(cosdem_master::tradeoff::PARETO_FILE);

@@ -22,7 +22,7 @@ use crate::post::CurveMetrics;
 use crate::solve::{SolutionView, StepObserver, StepReport};
 use cosdem_common::Answer;
 use cosdem_common::GaussPointId;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -57,8 +57,11 @@ pub struct RunSettings {
     pub linear_range: f64,
 }
 
-/// The summary, rewritten atomically after every step.
-#[derive(Clone, Debug, Default, Serialize)]
+/// The summary, rewritten atomically after every step. It reads back (a field missing from an
+/// older file takes its default) so that a finished run can be reused (`bench tradeoff
+/// --resume`).
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+#[serde(default)]
 pub struct Summary {
     /// The job's title.
     pub title: String,
@@ -89,6 +92,9 @@ pub struct Summary {
     /// Steps accepted under `newton.tolerated_residual` (ran out of iterations above the
     /// force tolerance): their imbalance is in the log.
     pub tolerated_steps: u64,
+    /// Of those, steps forced through at the smallest increment above the tolerated residual
+    /// (`newton.forced_residual`).
+    pub forced_steps: u64,
     /// Wall time so far (s); not deterministic.
     pub wall_seconds: f64,
     /// Workers used (set by the caller).
@@ -226,6 +232,7 @@ impl RunWriter {
             linear_answers: count("linear_answers"),
             max_error_bound: old["max_error_bound"].as_f64().unwrap_or(0.0),
             tolerated_steps: count("tolerated_steps"),
+            forced_steps: count("forced_steps"),
             wall_seconds: before,
             ..Summary::default()
         };
@@ -375,6 +382,7 @@ impl StepObserver for RunWriter {
         }
         self.summary.cuts += u64::from(report.cuts);
         self.summary.tolerated_steps += u64::from(report.tolerated);
+        self.summary.forced_steps += u64::from(report.forced);
         self.summary.metrics = CurveMetrics::from_curve(&self.curve, self.settings.linear_range);
         let row = [
             report.step as f64,

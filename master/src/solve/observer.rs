@@ -29,6 +29,9 @@ pub struct StepReport {
     /// [`crate::solve::SolverSettings::tolerated_residual`] (its last residual is in
     /// `residuals`), not converged to the force or displacement tolerance.
     pub tolerated: bool,
+    /// A tolerated step accepted at the smallest increment above `tolerated_residual`, under
+    /// [`crate::solve::SolverSettings::forced_residual`].
+    pub forced: bool,
     /// Reaction `[R_x, R_y, R_w]` (N, N, N m per metre of thickness) of every named node set:
     /// the sum of `f_int - f_ext` over the set's dofs.
     pub reactions: BTreeMap<String, [f64; 3]>,
