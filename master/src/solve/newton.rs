@@ -804,7 +804,10 @@ impl Solver {
             }
             let tolerated = best.as_ref().is_some_and(|(b, _)| *b <= accepted);
             let stall = self.settings.stall_iterations;
-            let stalled = stall > 0 && tolerated && k - best_at >= stall;
+            // The stall ends only an attempt tolerated without the forced residual: one
+            // forced early could have come within the tolerated residual later.
+            let within = best.as_ref().is_some_and(|(b, _)| *b <= tolerated_residual);
+            let stalled = stall > 0 && within && k - best_at >= stall;
             if stalled {
                 tracing::debug!(iterations = k, since = best_at, "stalled");
             }
