@@ -815,11 +815,8 @@ fn run_variant(
             ended
         }
         None => {
-            std::fs::create_dir_all(&dir).map_err(|source| crate::output::OutputError::Io {
-                path: dir.clone(),
-                action: "create directory",
-                source,
-            })?;
+            std::fs::create_dir_all(&dir)
+                .map_err(crate::output::io_err(&dir, "create directory"))?;
             let json = serde_json::to_string_pretty(&v.job)?;
             crate::output::write_atomic(&dir.join(VARIANT_FILE), json.as_bytes())?;
             crate::run::run_job(&v.job, &dir, workers)?

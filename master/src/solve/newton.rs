@@ -527,8 +527,8 @@ impl Solver {
                         reactions: self.reactions.clone(),
                         dem_steps: self.evaluated_steps.take(),
                     };
+                    let residual = report.residuals.last().copied().unwrap_or(f64::NAN);
                     if forced {
-                        let residual = report.residuals.last().copied().unwrap_or(f64::NAN);
                         tracing::warn!(
                             iterations,
                             cuts,
@@ -536,7 +536,6 @@ impl Solver {
                             "step forced through at the smallest increment"
                         );
                     } else if tolerated {
-                        let residual = report.residuals.last().copied().unwrap_or(f64::NAN);
                         tracing::warn!(iterations, cuts, residual, "step accepted as tolerated");
                     } else {
                         tracing::info!(iterations, cuts, "step converged");
