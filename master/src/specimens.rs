@@ -140,9 +140,43 @@ fn curve_of(s: &Specimen, i: usize) -> &[(f64, f64)] {
     s.curves.get(i).map_or(&[], Vec::as_slice)
 }
 
+/// What a row ran: the knob settings it moves from the job as given, sorted
+/// (`knob=setting`; a combination row, [`crate::accuracy::COMBINATIONS`], lists its own
+/// after the target: `accuracy` `0.2: a=1+b=2` moves `a=1` and `b=2`).
+fn moves(r: &Row) -> Vec<String> {
+    if !crate::accuracy::COMBINATIONS.contains(&r.knob.as_str()) {
+        return vec![format!("{}={}", r.knob, r.setting)];
+    }
+    let list = r.setting.split_once(": ").map_or(r.setting.as_str(), |(_, l)| l);
+    let mut v: Vec<String> = list.split('+').map(str::to_string).collect();
+    v.sort();
+    v
+}
+
+/// The averaged row's knob and setting: the specimens' own when they agree; otherwise
+/// (one sweep's `cheapest` is another's `accuracy 0.2` pick: [`tradeoff::combinations`]
+/// runs the same settings once) every name it has, and the settings it moves.
+fn label(per: &[&Row], key: &[String]) -> (String, String) {
+    if per.iter().all(|r| (&r.knob, &r.setting) == (&per[0].knob, &per[0].setting)) {
+        return (per[0].knob.clone(), per[0].setting.clone());
+    }
+    let mut names: Vec<String> = Vec::new();
+    for r in per {
+        let name = match r.setting.split_once(": ") {
+            Some((target, _)) if r.knob == "accuracy" => format!("accuracy {target}"),
+            _ => r.knob.clone(),
+        };
+        if !names.contains(&name) {
+            names.push(name);
+        }
+    }
+    (names.join(" / "), key.join("+"))
+}
+
 /// Averages the sweeps of several specimens (see the module's docs). Rows are matched by
-/// knob and setting; the first specimen's order is kept; a row some specimen lacks is
-/// dropped (and named in [`Averaged::dropped`]).
+/// what they ran ([`moves`]), whatever each sweep called them; the first specimen's order
+/// is kept, and a row that repeats an earlier one's settings there is left out (the same
+/// run again); a row some specimen lacks is dropped (and named in [`Averaged::dropped`]).
 pub fn average(specimens: &[Specimen]) -> Result<Averaged, SpecimensError> {
     if specimens.len() < 2 {
         return Err(SpecimensError::TooFew(specimens.len()));
@@ -159,9 +193,7 @@ pub fn average(specimens: &[Specimen]) -> Result<Averaged, SpecimensError> {
             });
         }
     }
-    let find = |s: &Specimen, r: &Row| {
-        s.rows.iter().position(|o| o.knob == r.knob && o.setting == r.setting)
-    };
+    let find = |s: &Specimen, key: &[String]| s.rows.iter().position(|o| moves(o) == key);
     // The references' mean curve on the first reference's grid is every row's grid.
     let grid = curve_of(&specimens[0], 0);
     let mut reference: Option<tradeoff::Reference> = None;
@@ -174,12 +206,19 @@ pub fn average(specimens: &[Specimen]) -> Result<Averaged, SpecimensError> {
     let e: fn(&CurveMetrics) -> Option<f64> = |m| m.stiffness;
     let refs: Vec<&Row> = specimens.iter().map(|s| &s.rows[0]).collect();
     let (mut rows, mut spread, mut dropped) = (Vec::new(), Vec::new(), Vec::new());
-    for r in &specimens[0].rows {
-        let Some(at) = specimens.iter().map(|s| find(s, r)).collect::<Option<Vec<usize>>>() else {
+    for (j, r) in specimens[0].rows.iter().enumerate() {
+        let key = moves(r);
+        // A combination that repeats an earlier row's settings is that row run again.
+        if specimens[0].rows[..j].iter().any(|o| moves(o) == key) {
+            continue;
+        }
+        let Some(at) = specimens.iter().map(|s| find(s, &key)).collect::<Option<Vec<usize>>>()
+        else {
             dropped.push(format!("{} = {}", r.knob, r.setting));
             continue;
         };
         let per: Vec<&Row> = specimens.iter().zip(&at).map(|(s, &i)| &s.rows[i]).collect();
+        let (knob, setting) = label(&per, &key);
         let curves: Vec<&[(f64, f64)]> =
             specimens.iter().zip(&at).map(|(s, &i)| curve_of(s, i)).collect();
         let metrics = CurveMetrics {
@@ -198,8 +237,8 @@ pub fn average(specimens: &[Specimen]) -> Result<Averaged, SpecimensError> {
         };
         let errors = tradeoff::compare((rm, rc), (&metrics, &curve));
         rows.push(Row {
-            knob: r.knob.clone(),
-            setting: r.setting.clone(),
+            knob,
+            setting,
             status,
             displacement: per.iter().map(|r| r.displacement).fold(f64::INFINITY, f64::min),
             wall_seconds: wall,
@@ -263,12 +302,12 @@ pub fn markdown(title: &str, a: &Averaged) -> String {
          |---|---|---|---|---:|---:|---:|---:|---:|---:|---:|\n",
     );
     let pct = |e: Option<f64>| e.map_or("-".into(), |e| format!("{:.2} %", 100.0 * e));
-    for (r, d) in a.rows.iter().zip(&a.spread) {
+    for d in &a.spread {
         for (label, p) in a.labels.iter().zip(&d.per_specimen) {
             s.push_str(&format!(
                 "| {} | {} | {} | {} | {:.1} | {:.0} | {} | {} | {} | {} | {} |\n",
-                r.knob,
-                r.setting,
+                p.knob,
+                p.setting,
                 label,
                 p.status,
                 p.wall_seconds,

@@ -681,6 +681,19 @@ fn point_label(r: &Row) -> String {
             let target = r.setting.split(':').next().unwrap_or("");
             format!("accuracy {target} pick{failed}")
         }
+        // A specimen-averaged row that the sweeps named differently
+        // (`cheapest / accuracy 0.2`, see `crate::specimens`).
+        k if k.contains(" / ") => {
+            let names: Vec<String> = k
+                .split(" / ")
+                .map(|n| match n {
+                    "cheapest" => "cheapest set".into(),
+                    n if n.starts_with("accuracy ") => format!("{n} pick"),
+                    n => n.into(),
+                })
+                .collect();
+            format!("{}{failed}", names.join(" / "))
+        }
         k => {
             let k = k.strip_prefix("relaxation.").unwrap_or(k);
             format!("{k}={}{failed}", r.setting)
@@ -935,6 +948,24 @@ mod tests {
             errors: Errors { peak: Some(e), residual: Some(e), stiffness: Some(e), curve: Some(e) },
             speedup: 1.0,
         }
+    }
+
+    /// The plot names a combination by what it is, also when specimens named it differently
+    /// (`cheapest / accuracy 0.2`, from `crate::specimens::average`), and marks a failed run.
+    #[test]
+    fn point_labels_name_combinations() {
+        let named = |knob: &str, setting: &str, status: &str| {
+            let mut r = row(1.0, 0.0);
+            (r.knob, r.setting, r.status) = (knob.into(), setting.into(), status.into());
+            point_label(&r)
+        };
+        assert_eq!(named("cheapest", "a=1+b=2", "finished"), "cheapest set");
+        assert_eq!(named("accuracy", "0.2: a=1", "finished"), "accuracy 0.2 pick");
+        assert_eq!(
+            named("cheapest / accuracy 0.2", "a=1+b=2", "finished"),
+            "cheapest set / accuracy 0.2 pick"
+        );
+        assert_eq!(named("relaxation.tolerance", "1e-3", "failed: x"), "tolerance=1e-3 (failed)");
     }
 
     /// The front keeps the rows no other row beats on both time and error.

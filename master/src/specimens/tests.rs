@@ -119,6 +119,47 @@ fn missing_and_failed_rows() {
     assert_eq!(w.errors.curve, Some(0.0));
 }
 
+/// Rows are matched by the settings they ran, not by their names: a sweep runs a
+/// combination once, so seed-2's cheapest set (`b=2+a=1`, the same as its `accuracy 0.2`
+/// pick) is its `accuracy` row while seed-1 calls it `cheapest`. The averaged row names
+/// both and lists the settings; the per-specimen table keeps each sweep's own name. Seed-1's
+/// `accuracy 0.1` pick repeats its one-knob row `a = 1` (the same run again) and is left out
+/// rather than averaged with seed-2's `a = 1`, which is counted once already.
+#[test]
+fn rows_are_matched_by_what_they_ran() {
+    let a = specimen(
+        "seed-1",
+        vec![
+            row("reference", "tight", 100.0, 1000.0, Some(100.0), 2e7),
+            row("a", "1", 10.0, 1000.0, Some(100.0), 2e7),
+            row("accuracy", "0.1: a=1", 10.0, 1000.0, Some(100.0), 2e7),
+            row("cheapest", "a=1+b=2", 2.0, 1010.0, Some(104.0), 2e7),
+        ],
+        Vec::new(),
+    );
+    let b = specimen(
+        "seed-2",
+        vec![
+            row("reference", "tight", 100.0, 1000.0, Some(100.0), 2e7),
+            row("a", "1", 10.0, 1000.0, Some(100.0), 2e7),
+            row("accuracy", "0.2: b=2+a=1", 3.0, 1030.0, Some(96.0), 2e7),
+        ],
+        Vec::new(),
+    );
+    let avg = average(&[a, b]).unwrap();
+    assert!(avg.dropped.is_empty(), "{:?}", avg.dropped);
+    let names: Vec<(&str, &str)> =
+        avg.rows.iter().map(|r| (r.knob.as_str(), r.setting.as_str())).collect();
+    assert_eq!(names, [("reference", "tight"), ("a", "1"), ("cheapest / accuracy 0.2", "a=1+b=2")]);
+    let c = &avg.rows[2];
+    assert_eq!((c.wall_seconds, c.metrics.peak_load), (5.0, 1020.0));
+    assert!((c.errors.peak.unwrap() - 0.02).abs() < 1e-12, "{:?}", c.errors);
+    assert_eq!(c.errors.residual, Some(0.0));
+    let md = markdown("t", &avg);
+    assert!(md.contains("| cheapest | a=1+b=2 | seed-1 |"), "{md}");
+    assert!(md.contains("| accuracy | 0.2: b=2+a=1 | seed-2 |"), "{md}");
+}
+
 /// One specimen, the same specimen twice, or a sweep whose first row is not its reference,
 /// is refused by name.
 #[test]
@@ -235,4 +276,23 @@ fn the_committed_specimen_table_is_the_mean_of_its_sweeps() {
         assert!(error(a.errors.residual, c.errors.residual), "{k}");
         assert!(error(a.errors.stiffness, c.errors.stiffness), "{k}");
     }
+}
+
+/// The committed specimen table of the re-sweep with the fixed Newton criterion
+/// (`docs/tradeoff-biaxial-10mm-fixed/specimens/`) is what [`average`] and [`markdown`] make
+/// of the three committed sweep directories beside it, curves included: the CSV and the
+/// Markdown are byte for byte the tool's output on the committed inputs (the same pure
+/// arithmetic on the same decimal inputs gives the same bits, so no tolerance is needed).
+#[test]
+fn the_committed_fixed_specimen_table_is_the_mean_of_its_sweeps() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/tradeoff-biaxial-10mm-fixed");
+    let sweeps: Vec<Specimen> =
+        ["seed-7", "seed-8", "seed-9"].iter().map(|s| read_sweep(&dir.join(s)).unwrap()).collect();
+    assert!(sweeps.iter().all(|s| s.curves.iter().all(|c| !c.is_empty())), "a curve is missing");
+    let avg = average(&sweeps).unwrap();
+    let committed = |name: &str| std::fs::read_to_string(dir.join("specimens").join(name)).unwrap();
+    assert_eq!(tradeoff::csv(&avg.rows), committed("tradeoff.csv"));
+    let md = committed("tradeoff.md");
+    let title = md.lines().next().unwrap().trim_start_matches("# ");
+    assert_eq!(markdown(title, &avg), md);
 }
