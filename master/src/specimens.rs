@@ -193,7 +193,10 @@ pub fn average(specimens: &[Specimen]) -> Result<Averaged, SpecimensError> {
             });
         }
     }
-    let find = |s: &Specimen, key: &[String]| s.rows.iter().position(|o| moves(o) == key);
+    // What each row of each specimen ran, worked out once.
+    let keys: Vec<Vec<Vec<String>>> =
+        specimens.iter().map(|s| s.rows.iter().map(moves).collect()).collect();
+    let find = |k: &[Vec<String>], key: &[String]| k.iter().position(|o| o.as_slice() == key);
     // The references' mean curve on the first reference's grid is every row's grid.
     let grid = curve_of(&specimens[0], 0);
     let mut reference: Option<tradeoff::Reference> = None;
@@ -206,19 +209,17 @@ pub fn average(specimens: &[Specimen]) -> Result<Averaged, SpecimensError> {
     let e: fn(&CurveMetrics) -> Option<f64> = |m| m.stiffness;
     let refs: Vec<&Row> = specimens.iter().map(|s| &s.rows[0]).collect();
     let (mut rows, mut spread, mut dropped) = (Vec::new(), Vec::new(), Vec::new());
-    for (j, r) in specimens[0].rows.iter().enumerate() {
-        let key = moves(r);
+    for (j, (r, key)) in specimens[0].rows.iter().zip(&keys[0]).enumerate() {
         // A combination that repeats an earlier row's settings is that row run again.
-        if specimens[0].rows[..j].iter().any(|o| moves(o) == key) {
+        if keys[0][..j].contains(key) {
             continue;
         }
-        let Some(at) = specimens.iter().map(|s| find(s, &key)).collect::<Option<Vec<usize>>>()
-        else {
+        let Some(at) = keys.iter().map(|k| find(k, key)).collect::<Option<Vec<usize>>>() else {
             dropped.push(format!("{} = {}", r.knob, r.setting));
             continue;
         };
         let per: Vec<&Row> = specimens.iter().zip(&at).map(|(s, &i)| &s.rows[i]).collect();
-        let (knob, setting) = label(&per, &key);
+        let (knob, setting) = label(&per, key);
         let curves: Vec<&[(f64, f64)]> =
             specimens.iter().zip(&at).map(|(s, &i)| curve_of(s, i)).collect();
         let metrics = CurveMetrics {
