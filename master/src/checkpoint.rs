@@ -219,12 +219,32 @@ pub struct Checkpointer<O> {
     every: u64,
     digests: Digests,
     stop: Arc<AtomicBool>,
+    max_steps: Option<u64>,
 }
 
 impl<O: StepObserver> Checkpointer<O> {
     /// Checkpoints into `dir/checkpoint.bin`.
     pub fn new(inner: O, dir: &Path, every: usize, job: &Job, stop: Arc<AtomicBool>) -> Self {
-        Self { inner, path: dir.join(FILE), every: every as u64, digests: Digests::of(job), stop }
+        Self {
+            inner,
+            path: dir.join(FILE),
+            every: every as u64,
+            digests: Digests::of(job),
+            stop,
+            max_steps: None,
+        }
+    }
+
+    /// Also stops the run cleanly (checkpoint written) once `max_steps` steps are committed
+    /// (`cosdem run --max-steps`): the run can go on later with `--resume`.
+    pub fn stop_at(mut self, max_steps: Option<u64>) -> Self {
+        self.max_steps = max_steps;
+        self
+    }
+
+    /// Whether the run reached its `max_steps` at `step`.
+    pub fn reached(&self, step: u64) -> bool {
+        self.max_steps.is_some_and(|k| step >= k)
     }
 }
 
@@ -235,7 +255,9 @@ impl<O: StepObserver> StepObserver for Checkpointer<O> {
 
     fn after_step(&mut self, solver: &Solver, material: &mut dyn Material) -> Result<StepControl> {
         let inner = self.inner.after_step(solver, material)?;
-        let stop = inner == StepControl::Stop || self.stop.load(Ordering::SeqCst);
+        let stop = inner == StepControl::Stop
+            || self.stop.load(Ordering::SeqCst)
+            || self.reached(solver.step());
         if stop || (self.every > 0 && solver.step().is_multiple_of(self.every)) {
             let _s = tracing::info_span!("checkpoint", step = solver.step()).entered();
             Checkpoint::capture(solver, material, self.digests)?.write(&self.path)?;

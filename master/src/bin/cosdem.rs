@@ -360,6 +360,11 @@ struct RunArgs {
     /// to come are solved with the job's; e.g. more iterations for a run that stalled).
     #[arg(long, requires = "resume")]
     newton_changed: bool,
+    /// Stop cleanly after this many committed steps (counted from the start of the run,
+    /// resumed steps included): checkpoint written, status `stopped`, exit code 0; go on later
+    /// with `--resume`.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    max_steps: Option<u64>,
 }
 
 #[derive(Subcommand)]
@@ -690,13 +695,19 @@ fn run(args: RunArgs) -> Result<()> {
     let outcome = {
         let progress = Progress { writer: &mut writer, bar: bar.clone(), started: Instant::now() };
         let every = job.output.checkpoint_every;
-        let mut observer = Checkpointer::new(progress, &dir, every, &job, stop);
-        solver.run(&mut material, &mut observer)
+        let mut observer =
+            Checkpointer::new(progress, &dir, every, &job, stop).stop_at(args.max_steps);
+        let outcome = solver.run(&mut material, &mut observer);
+        (outcome, observer.reached(solver.step()))
     };
+    let (outcome, reached_max) = outcome;
     bar.finish_and_clear();
     writer.add_uncommitted_dem_steps(solver.uncommitted_dem_steps());
-    let interrupted = matches!(outcome, Err(cosdem_master::Error::Interrupted { .. }));
-    if interrupted {
+    let stopped = matches!(outcome, Err(cosdem_master::Error::Interrupted { .. }));
+    let interrupted = stopped && !reached_max;
+    if stopped && reached_max {
+        writer.finish_stopped()?;
+    } else if interrupted {
         writer.finish_interrupted()?;
     } else {
         writer.finish(outcome.as_ref().map(|_| ()).map_err(|e| e.to_string()))?;
@@ -732,6 +743,14 @@ fn run(args: RunArgs) -> Result<()> {
             dir.display(),
             args.job.display()
         );
+    }
+    if stopped {
+        println!(
+            "stopped after step {} (--max-steps); continue with `cosdem run {} --resume`",
+            s.steps,
+            args.job.display()
+        );
+        return Ok(());
     }
     outcome.with_context(|| format!("run stopped; finished steps are in {}", dir.display()))?;
     Ok(())

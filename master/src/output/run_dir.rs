@@ -261,6 +261,13 @@ impl RunWriter {
         self.write_summary()
     }
 
+    /// Marks the run stopped at `cosdem run --max-steps` (resume with `--resume`) and writes
+    /// the summary.
+    pub fn finish_stopped(&mut self) -> Result<()> {
+        self.summary.status = "stopped".into();
+        self.write_summary()
+    }
+
     /// The run directory.
     pub fn dir(&self) -> &Path {
         &self.dir
