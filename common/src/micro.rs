@@ -22,7 +22,7 @@ pub enum BoundaryKind {
 /// How to build an assembly: the DEM spec as JSON plus hints readable without parsing it.
 ///
 /// v1 carries the DEM spec as JSON; the schema is the job file's `[assembly]` table
-/// (`cosdem_worker::AssemblySpec`). The JSON is authoritative; the hints serve limits and
+/// (`cosdem_dem::AssemblySpec`). The JSON is authoritative; the hints serve limits and
 /// load balancing.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct AssemblyRequest {

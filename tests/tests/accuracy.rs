@@ -1,6 +1,6 @@
 //! The accuracy target keeps its promise on a scene the measured table was not made on.
 //!
-//! The table (`docs/tradeoff-scene-a.csv`) is scene A: a 1 x 1 m panel, 2 x 2 elements,
+//! The table (`docs/notes/tradeoff-scene-a.csv`) is scene A: a 1 x 1 m panel, 2 x 2 elements,
 //! 100 kPa confinement, 105-disc assemblies (V = 0.01 m^2), 2 mm load steps to 0.03 m. The
 //! scene here differs in every one of those: a slender 0.5 x 1 m panel (aspect 2) of 1 x 2
 //! elements, 150 kPa confinement, smaller assemblies (side 0.08 m, V = 0.0064 m^2), to
@@ -17,9 +17,10 @@
 //!   asserted on a shared machine).
 //! - the run directory holds `accuracy.json` naming what was picked.
 
-use cosdem_master::job::Job;
-use cosdem_master::run::{WorkerChoice, run_job};
-use cosdem_master::tradeoff::{compare, reference};
+use cosdem_app::run::{WorkerChoice, run_job};
+use cosdem_job::Job;
+use cosdem_tune::knob::reference;
+use cosdem_tune::table::compare;
 use std::time::Instant;
 
 const SCENE: &str = r#"
@@ -70,7 +71,7 @@ fn accuracy_target_holds_on_a_scene_the_table_was_not_measured_on() {
 }
 
 /// The same scene with random polydisperse assemblies (radii 4-6 mm, equilibrated at
-/// 150 kPa, a penalty boundary): planned from the random table (`docs/tradeoff-biaxial-1mm.csv`:
+/// 150 kPa, a penalty boundary): planned from the random table (`docs/notes/tradeoff-biaxial-1mm.csv`:
 /// periodic 2-3 mm assemblies, smooth platens, 100 kPa), which this scene differs from in
 /// radii, boundary, platens, confinement and mesh. Its default is 2.9 % from its reference
 /// (the half load step), so only a 10 % target moves knobs; the promise is checked at 10 %.

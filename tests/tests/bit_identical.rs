@@ -3,8 +3,8 @@
 
 mod common;
 use common::*;
-use cosdem_master::pool::Pool;
-use cosdem_worker::service::StandIn;
+use cosdem_pool::Pool;
+use cosdem_worker::StandIn;
 
 #[test]
 fn in_process_one_and_three_workers_agree() {

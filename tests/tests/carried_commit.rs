@@ -7,10 +7,10 @@
 mod common;
 use common::*;
 use cosdem_common::{GaussPointId, MacroDeformation};
-use cosdem_master::pool::{Pool, PoolConfig};
+use cosdem_pool::{Pool, PoolConfig};
 use cosdem_proto::v1 as pb;
 use cosdem_proto::v1::micro_solver_client::MicroSolverClient;
-use cosdem_worker::service::{StandIn, WorkerConfig};
+use cosdem_worker::{StandIn, WorkerConfig};
 use tonic::Code;
 use tonic::transport::Channel;
 

@@ -3,7 +3,7 @@
 
 mod common;
 use common::*;
-use cosdem_master::pool::Pool;
+use cosdem_pool::Pool;
 
 #[test]
 fn a_name_resolving_to_addresses_gives_workers() {

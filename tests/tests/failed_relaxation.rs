@@ -4,9 +4,9 @@
 mod common;
 use common::*;
 use cosdem_common::{GaussPointId, MacroDeformation};
-use cosdem_master::material::{Material, MaterialError, MaterialInput, TrialId};
-use cosdem_master::pool::Pool;
-use cosdem_worker::service::StandIn;
+use cosdem_fem::material::{Material, MaterialError, MaterialInput, TrialId};
+use cosdem_pool::Pool;
+use cosdem_worker::StandIn;
 
 #[test]
 fn failed_relaxation_names_the_gauss_point() {

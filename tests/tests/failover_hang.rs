@@ -4,7 +4,7 @@
 
 mod common;
 use common::*;
-use cosdem_master::pool::{Pool, PoolConfig};
+use cosdem_pool::{Pool, PoolConfig};
 use std::time::Duration;
 
 #[test]
@@ -29,7 +29,7 @@ fn a_hanging_worker_misses_its_deadline_and_is_replaced() {
 
 #[test]
 fn a_hanging_in_process_worker_is_replaced() {
-    use cosdem_worker::service::{StandIn, StandInOptions};
+    use cosdem_worker::{StandIn, StandInOptions};
     let reference = reference(100, 20);
     let config = PoolConfig { solve_timeout: Duration::from_millis(800), ..test_config() };
     let mut pool = Pool::in_process(3, config, |i| {

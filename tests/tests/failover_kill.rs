@@ -3,7 +3,7 @@
 
 mod common;
 use common::*;
-use cosdem_master::pool::{Pool, PoolConfig};
+use cosdem_pool::{Pool, PoolConfig};
 
 /// Kills worker 0 mid-step 2 and worker 1 after step 4's last iteration.
 fn kill_two(config: PoolConfig) {

@@ -5,7 +5,7 @@
 
 mod common;
 use common::*;
-use cosdem_master::pool::{Pool, PoolConfig};
+use cosdem_pool::{Pool, PoolConfig};
 
 /// Three worker processes and a pool over them exporting every `k` commits (no rebalancing:
 /// a migration exports fresh states, which would shorten what a failover replays).
@@ -85,8 +85,7 @@ fn with_export_at_every_commit_nothing_is_replayed() {
 #[test]
 fn export_every_zero_is_refused() {
     let config = PoolConfig { export_every: 0, ..test_config() };
-    let err = Pool::in_process(1, config, |_| cosdem_worker::service::StandIn::new())
-        .err()
-        .expect("refused");
+    let err =
+        Pool::in_process(1, config, |_| cosdem_worker::StandIn::new()).err().expect("refused");
     assert!(err.to_string().contains("export_every = 0"), "{err}");
 }

@@ -6,7 +6,7 @@ use common::*;
 use cosdem_common::{GaussPointId, MacroDeformation};
 use cosdem_proto::PROTOCOL_VERSION;
 use cosdem_proto::v1 as pb;
-use cosdem_worker::service::{Limits, StandIn, StandInOptions, WorkerConfig};
+use cosdem_worker::{Limits, StandIn, StandInOptions, WorkerConfig};
 use std::time::{Duration, Instant};
 use tonic::Code;
 

@@ -5,7 +5,7 @@ mod common;
 use common::*;
 use cosdem_common::{GaussPointId, MacroDeformation};
 use cosdem_proto::v1 as pb;
-use cosdem_worker::service::{StandIn, WorkerConfig};
+use cosdem_worker::{StandIn, WorkerConfig};
 
 async fn solve(
     c: &mut cosdem_proto::v1::micro_solver_client::MicroSolverClient<tonic::transport::Channel>,
@@ -97,10 +97,10 @@ async fn solve_batch_and_commit_retries_are_idempotent() {
 
 #[test]
 fn pool_commit_twice_is_a_no_op() {
-    use cosdem_master::material::{Material, MaterialInput, TrialId};
+    use cosdem_fem::material::{Material, MaterialInput, TrialId};
     // Export at every commit, so that the stored states show the commit.
-    let config = cosdem_master::pool::PoolConfig { export_every: 1, ..test_config() };
-    let mut pool = cosdem_master::pool::Pool::in_process(2, config, |_| StandIn::new()).unwrap();
+    let config = cosdem_pool::PoolConfig { export_every: 1, ..test_config() };
+    let mut pool = cosdem_pool::Pool::in_process(2, config, |_| StandIn::new()).unwrap();
     create(&mut pool, 10, 1);
     let inputs: Vec<_> = gauss_points()
         .into_iter()

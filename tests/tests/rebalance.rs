@@ -3,7 +3,7 @@
 
 mod common;
 use common::*;
-use cosdem_master::pool::Pool;
+use cosdem_pool::Pool;
 
 #[test]
 fn a_returning_worker_is_used_from_the_next_step() {
@@ -37,7 +37,7 @@ fn a_returning_worker_is_used_from_the_next_step() {
 
 #[test]
 fn placement_follows_disc_counts() {
-    use cosdem_worker::service::StandIn;
+    use cosdem_worker::StandIn;
     let mut pool = Pool::in_process(2, test_config(), |_| StandIn::new()).unwrap();
     // One big assembly and four small ones: the big one gets a worker to itself.
     let big = cosdem_common::GaussPointId::new(0, 0);

@@ -5,10 +5,10 @@
 
 use cosdem_common::micro::{AssemblyRequest, BoundaryKind};
 use cosdem_common::{Answer, GaussPointId};
-use cosdem_master::job::{Job, MaterialSection};
-use cosdem_master::pool::{Pool, PoolConfig};
-use cosdem_master::solve::{SolutionView, Solver, StepObserver, StepReport};
-use cosdem_worker::service::Dem;
+use cosdem_fem::solve::{SolutionView, Solver, StepObserver, StepReport};
+use cosdem_job::{Job, MaterialSection};
+use cosdem_pool::{Pool, PoolConfig};
+use cosdem_worker::Dem;
 
 #[derive(Default, PartialEq, Debug)]
 struct Record {
@@ -17,7 +17,7 @@ struct Record {
 }
 
 impl StepObserver for Record {
-    fn on_step(&mut self, r: &StepReport, s: &SolutionView<'_>) -> cosdem_master::Result<()> {
+    fn on_step(&mut self, r: &StepReport, s: &SolutionView<'_>) -> cosdem_fem::Result<()> {
         for v in r.reactions.values() {
             self.bits.extend(v.iter().map(|x| x.to_bits()));
         }

@@ -3,7 +3,7 @@
 mod common;
 use common::*;
 use cosdem_common::GaussPointId;
-use cosdem_master::pool::Pool;
+use cosdem_pool::Pool;
 use cosdem_proto::v1 as pb;
 use std::time::{Duration, Instant};
 

@@ -4,7 +4,7 @@ mod common;
 use common::*;
 use cosdem_common::{GaussPointId, MacroDeformation};
 use cosdem_proto::v1 as pb;
-use cosdem_worker::service::{Limits, StandIn, WorkerConfig};
+use cosdem_worker::{Limits, StandIn, WorkerConfig};
 use tonic::Code;
 
 fn gp(e: u32) -> pb::GaussPoint {

@@ -13,11 +13,11 @@
 
 use cosdem_common::GaussPointId;
 use cosdem_common::micro::{AssemblyRequest, BoundaryKind};
-use cosdem_master::job::{Job, MaterialSection};
-use cosdem_master::material::ElasticCosserat;
-use cosdem_master::pool::{Pool, PoolConfig};
-use cosdem_master::solve::Solver;
-use cosdem_worker::service::Dem;
+use cosdem_fem::material::ElasticCosserat;
+use cosdem_fem::solve::Solver;
+use cosdem_job::{Job, MaterialSection};
+use cosdem_pool::{Pool, PoolConfig};
+use cosdem_worker::Dem;
 
 const ELASTIC: &str = r#"
     [mesh]
@@ -47,7 +47,7 @@ fn with_symmetry(text: &str, sym: &str) -> String {
 }
 
 /// `(displacement, load)` of every step: `load = -scale * R_y(load_set)`.
-fn curve(job: &Job, material: &mut dyn cosdem_master::material::Material) -> Vec<(f64, f64)> {
+fn curve(job: &Job, material: &mut dyn cosdem_fem::material::Material) -> Vec<(f64, f64)> {
     let mut solver = Solver::new(job.model().unwrap(), job.solver_settings().unwrap()).unwrap();
     let mut reports = Vec::new();
     solver.run(material, &mut reports).unwrap();

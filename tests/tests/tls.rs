@@ -3,8 +3,8 @@
 
 mod common;
 use common::*;
-use cosdem_master::pool::{ClientTls, Pool, PoolConfig};
-use cosdem_worker::service::{StandIn, TlsIdentity, Token, WorkerConfig};
+use cosdem_pool::{ClientTls, Pool, PoolConfig};
+use cosdem_worker::{StandIn, TlsIdentity, Token, WorkerConfig};
 
 #[test]
 fn tls_worker_and_pool() {

@@ -3,10 +3,10 @@
 
 mod common;
 use common::*;
-use cosdem_master::pool::{Pool, PoolConfig, PoolError};
+use cosdem_pool::{Pool, PoolConfig, PoolError};
 use cosdem_proto::PROTOCOL_VERSION;
 use cosdem_proto::v1 as pb;
-use cosdem_worker::service::{StandIn, Token, WorkerConfig};
+use cosdem_worker::{StandIn, Token, WorkerConfig};
 use tonic::Code;
 
 #[tokio::test]

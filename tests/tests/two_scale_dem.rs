@@ -6,10 +6,10 @@
 
 use cosdem_common::GaussPointId;
 use cosdem_common::micro::{AssemblyRequest, BoundaryKind};
-use cosdem_master::job::{Job, MaterialSection};
-use cosdem_master::pool::{Pool, PoolConfig};
-use cosdem_master::solve::{SolutionView, Solver, StepObserver, StepReport};
-use cosdem_worker::service::Dem;
+use cosdem_fem::solve::{SolutionView, Solver, StepObserver, StepReport};
+use cosdem_job::{Job, MaterialSection};
+use cosdem_pool::{Pool, PoolConfig};
+use cosdem_worker::Dem;
 
 #[derive(Default)]
 struct Record {
@@ -19,7 +19,7 @@ struct Record {
 }
 
 impl StepObserver for Record {
-    fn on_step(&mut self, r: &StepReport, s: &SolutionView<'_>) -> cosdem_master::Result<()> {
+    fn on_step(&mut self, r: &StepReport, s: &SolutionView<'_>) -> cosdem_fem::Result<()> {
         for v in r.reactions.values() {
             self.reactions.extend(v.iter().map(|x| x.to_bits()));
         }

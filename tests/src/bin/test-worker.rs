@@ -2,7 +2,7 @@
 //! Prints `LISTENING <addr>` on stdout once bound. (The real binary is `cosdem-worker`.)
 
 use clap::Parser;
-use cosdem_worker::service::{
+use cosdem_worker::{
     ListenArgs, StandIn, StandInOptions, WorkerConfig, bind, serve_listener, shutdown_signal,
 };
 use std::io::Write;

@@ -4,10 +4,10 @@
 
 use cosdem_common::micro::{AssemblyRequest, BoundaryKind};
 use cosdem_common::{GaussPointId, MacroDeformation, MicroResponse};
-use cosdem_master::material::{Material, MaterialInput, TrialId};
-use cosdem_master::pool::{Pool, PoolConfig};
+use cosdem_fem::material::{Material, MaterialInput, TrialId};
+use cosdem_pool::{Pool, PoolConfig};
 use cosdem_proto::v1::micro_solver_client::MicroSolverClient;
-use cosdem_worker::service::{StandIn, WorkerConfig, bind, serve_listener};
+use cosdem_worker::{StandIn, WorkerConfig, bind, serve_listener};
 use std::io::{BufRead, BufReader};
 use std::net::SocketAddr;
 use std::process::{Child, Command, Stdio};

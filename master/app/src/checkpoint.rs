@@ -1,0 +1,306 @@
+//! Checkpoints of a run, resume, and a clean stop on Ctrl-C.
+//!
+//! `RUN/checkpoint.bin` holds, at a committed step, the solver's evolving state
+//! ([`SolverState`]: dofs, load factor, step, next increment, the responses of the converged
+//! state, Gauss-point states, reactions) and every assembly's committed state (the bytes the
+//! workers export). It is written atomically (temporary file, sync, rename) every
+//! `[output] checkpoint_every` steps and when the run is stopped. A run resumed from it
+//! (`cosdem run JOB --resume`) goes on bit for bit as the uninterrupted run would have: a
+//! solve is deterministic given (committed state, target), and everything else is restored
+//! exactly (bincode stores each `f64` as its bit pattern).
+//!
+//! Format: the magic `CDEMCKP2`, then one bincode (standard config) [`Checkpoint`]. The
+//! checkpoint also stores a digest of the job's physics (mesh, loading, material) and one of
+//! its Newton settings: resuming with a job whose physics changed is refused, and so is one
+//! whose Newton settings changed unless the resume says so (`--newton-changed`): the steps
+//! already done stay as they were and only the steps to come are solved with the new
+//! settings (a run that stalls past a peak can go on with more iterations or another
+//! tolerance instead of starting again), so that run is no longer the uninterrupted run of
+//! either job.
+
+use crate::output::write_atomic;
+use cosdem_common::GaussPointId;
+use cosdem_common::micro::AssemblyState;
+use cosdem_fem::error::{Error, Result};
+use cosdem_fem::material::Material;
+use cosdem_fem::solve::{SolutionView, Solver, SolverState, StepControl, StepObserver, StepReport};
+use cosdem_job::Job;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+const MAGIC: &[u8; 8] = b"CDEMCKP2";
+
+/// The header of the format before the Newton settings had a digest of their own.
+const MAGIC_1: &[u8; 8] = b"CDEMCKP1";
+
+/// The checkpoint file's name in the run directory.
+pub const FILE: &str = "checkpoint.bin";
+
+/// One assembly's committed state.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SavedAssembly {
+    /// The Gauss point.
+    pub id: GaussPointId,
+    /// Its committed step.
+    pub committed_step: u64,
+    /// Discs.
+    pub disc_count: u64,
+    /// Model bytes (`Assembly::to_bytes`).
+    pub state: Vec<u8>,
+}
+
+/// Everything needed to continue a run.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Checkpoint {
+    /// Digests of the job's physics and of its Newton settings.
+    pub digests: Digests,
+    /// The solver's state.
+    pub solver: SolverState,
+    /// The material's committed states (empty for stateless materials).
+    pub assemblies: Vec<SavedAssembly>,
+}
+
+fn bad(path: &Path, message: String) -> Error {
+    Error::JobFile { file: path.display().to_string(), message }
+}
+
+impl Checkpoint {
+    /// Captures the solver and the material at the last committed step.
+    pub fn capture(solver: &Solver, material: &mut dyn Material, digests: Digests) -> Result<Self> {
+        let states = material.committed_states()?.unwrap_or_default();
+        let step = solver.step();
+        if let Some(s) = states.iter().find(|s| s.committed_step != step) {
+            return Err(Error::Observer(format!(
+                "checkpoint: {} is committed at step {}, the solver at step {step}",
+                s.id, s.committed_step
+            )));
+        }
+        let assemblies = states
+            .into_iter()
+            .map(|s| SavedAssembly {
+                id: s.id,
+                committed_step: s.committed_step,
+                disc_count: s.disc_count,
+                state: s.state,
+            })
+            .collect();
+        Ok(Self { digests, solver: solver.state(), assemblies })
+    }
+
+    /// The material's committed states, for [`Material::restore_states`].
+    pub fn assembly_states(&self) -> Vec<AssemblyState> {
+        self.assemblies
+            .iter()
+            .map(|a| AssemblyState {
+                id: a.id,
+                committed_step: a.committed_step,
+                state: a.state.clone(),
+                disc_count: a.disc_count,
+            })
+            .collect()
+    }
+
+    /// Writes the checkpoint atomically.
+    pub fn write(&self, path: &Path) -> Result<()> {
+        let mut bytes = MAGIC.to_vec();
+        let body = bincode::serde::encode_to_vec(self, bincode::config::standard())
+            .map_err(|e| bad(path, format!("encoding the checkpoint: {e}")))?;
+        bytes.extend_from_slice(&body);
+        write_atomic(path, &bytes).map_err(|e| Error::Observer(e.to_string()))
+    }
+
+    /// Reads a checkpoint written by [`Checkpoint::write`].
+    pub fn read(path: &Path) -> Result<Self> {
+        let bytes = std::fs::read(path).map_err(|e| bad(path, e.to_string()))?;
+        if bytes.starts_with(MAGIC_1) {
+            return Err(bad(
+                path,
+                "a checkpoint of the first format (CDEMCKP1, a cosdem without --newton-changed): \
+                 resume it with the cosdem that wrote it"
+                    .into(),
+            ));
+        }
+        if !bytes.starts_with(MAGIC) {
+            return Err(bad(path, "not a cosdem checkpoint (no CDEMCKP2 header)".into()));
+        }
+        let (c, used): (Self, usize) =
+            bincode::serde::decode_from_slice(&bytes[MAGIC.len()..], bincode::config::standard())
+                .map_err(|e| bad(path, format!("cannot decode the checkpoint: {e}")))?;
+        if MAGIC.len() + used != bytes.len() {
+            return Err(bad(path, "trailing bytes after the checkpoint".into()));
+        }
+        Ok(c)
+    }
+
+    /// Refuses a checkpoint of another job's physics.
+    ///
+    /// `newton_changed`: the job's `[newton]` settings may differ from the checkpoint's (the
+    /// steps to come are solved with the job's; a warning is logged).
+    pub fn check_job(&self, job: &Job, path: &Path, newton_changed: bool) -> Result<()> {
+        let Digests { job: d, newton: n } = Digests::of(job);
+        if d != self.digests.job {
+            return Err(bad(
+                path,
+                format!(
+                    "the checkpoint was written for another job (digest {:016x}, this job {d:016x}): \
+                     mesh, loading or material changed, or a cosdem whose job format has other \
+                     fields or defaults wrote it",
+                    self.digests.job
+                ),
+            ));
+        }
+        if n != self.digests.newton {
+            if !newton_changed {
+                return Err(bad(
+                    path,
+                    format!(
+                        "the checkpoint was written with other [newton] settings (digest \
+                         {:016x}, this job {n:016x}): the job's [newton] changed, or a cosdem \
+                         whose [newton] has other fields or defaults wrote it; resume with \
+                         --newton-changed to solve the steps to come with this job's",
+                        self.digests.newton
+                    ),
+                ));
+            }
+            tracing::warn!(
+                step = self.solver.step,
+                "[newton] settings changed at the resume: the steps from here on are solved with \
+                 the job's"
+            );
+        }
+        Ok(())
+    }
+}
+
+/// The digests a checkpoint stores.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Digests {
+    /// [`job_digest`].
+    pub job: u64,
+    /// [`newton_digest`].
+    pub newton: u64,
+}
+
+impl Digests {
+    /// The job's.
+    pub fn of(job: &Job) -> Self {
+        Self { job: job_digest(job), newton: newton_digest(job) }
+    }
+}
+
+/// FNV-1a digest of the job's physics: `[mesh]`, `[loading]`, `[material]` as JSON. Output
+/// and worker settings may change between a run and its resume.
+pub fn job_digest(job: &Job) -> u64 {
+    fnv1a(&serde_json::to_string(&(&job.mesh, &job.loading, &job.material)).unwrap_or_default())
+}
+
+/// FNV-1a digest of the job's `[newton]` settings as JSON.
+pub fn newton_digest(job: &Job) -> u64 {
+    fnv1a(&serde_json::to_string(&job.newton).unwrap_or_default())
+}
+
+fn fnv1a(text: &str) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in text.bytes() {
+        h ^= u64::from(b);
+        h = h.wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    h
+}
+
+/// Wraps a [`StepObserver`]: writes the checkpoint every `every` steps (0: only when
+/// stopping) and stops the run cleanly once `stop` is set (checkpoint written first).
+pub struct Checkpointer<O> {
+    /// The wrapped observer (sees every step first).
+    pub inner: O,
+    path: PathBuf,
+    every: u64,
+    digests: Digests,
+    stop: Arc<AtomicBool>,
+    max_steps: Option<u64>,
+}
+
+impl<O: StepObserver> Checkpointer<O> {
+    /// Checkpoints into `dir/checkpoint.bin`.
+    pub fn new(inner: O, dir: &Path, every: usize, job: &Job, stop: Arc<AtomicBool>) -> Self {
+        Self {
+            inner,
+            path: dir.join(FILE),
+            every: every as u64,
+            digests: Digests::of(job),
+            stop,
+            max_steps: None,
+        }
+    }
+
+    /// Also stops the run cleanly (checkpoint written) once `max_steps` steps are committed
+    /// (`cosdem run --max-steps`): the run can go on later with `--resume`.
+    pub fn stop_at(mut self, max_steps: Option<u64>) -> Self {
+        self.max_steps = max_steps;
+        self
+    }
+
+    /// Whether the run reached its `max_steps` at `step`.
+    pub fn reached(&self, step: u64) -> bool {
+        self.max_steps.is_some_and(|k| step >= k)
+    }
+}
+
+impl<O: StepObserver> StepObserver for Checkpointer<O> {
+    fn on_step(&mut self, report: &StepReport, state: &SolutionView<'_>) -> Result<()> {
+        self.inner.on_step(report, state)
+    }
+
+    fn after_step(&mut self, solver: &Solver, material: &mut dyn Material) -> Result<StepControl> {
+        let inner = self.inner.after_step(solver, material)?;
+        let stop = inner == StepControl::Stop
+            || self.stop.load(Ordering::SeqCst)
+            || self.reached(solver.step());
+        if stop || (self.every > 0 && solver.step().is_multiple_of(self.every)) {
+            let _s = tracing::info_span!("checkpoint", step = solver.step()).entered();
+            Checkpoint::capture(solver, material, self.digests)?.write(&self.path)?;
+        }
+        Ok(if stop { StepControl::Stop } else { StepControl::Continue })
+    }
+}
+
+/// A flag set by the first Ctrl-C (SIGINT) or SIGTERM (what Slurm, Kubernetes and
+/// `docker stop` send before they kill); a second one exits at once with status 130. Listens on
+/// a thread of its own (a one-thread tokio runtime), so the solver is never interrupted
+/// mid-step: the run stops after the current step with its checkpoint written.
+pub fn ctrl_c_flag() -> std::io::Result<Arc<AtomicBool>> {
+    let flag = Arc::new(AtomicBool::new(false));
+    let rt = tokio::runtime::Builder::new_current_thread().enable_all().build()?;
+    // Registered here, before the run starts, not when the thread first polls.
+    #[cfg(unix)]
+    let mut term = {
+        let _guard = rt.enter();
+        tokio::signal::unix::signal(tokio::signal::unix::SignalKind::terminate())?
+    };
+    let f = flag.clone();
+    std::thread::Builder::new().name("cosdem-ctrl-c".into()).spawn(move || {
+        rt.block_on(async move {
+            loop {
+                #[cfg(unix)]
+                let received = tokio::select! {
+                    r = tokio::signal::ctrl_c() => r.is_ok().then_some("Ctrl-C"),
+                    r = term.recv() => r.map(|()| "SIGTERM"),
+                };
+                #[cfg(not(unix))]
+                let received = tokio::signal::ctrl_c().await.is_ok().then_some("Ctrl-C");
+                let Some(what) = received else { return };
+                if f.swap(true, Ordering::SeqCst) {
+                    eprintln!("\nsecond {what}: exiting without waiting for the step");
+                    std::process::exit(130);
+                }
+                eprintln!("\n{what}: stopping after the current step (again to quit now)");
+            }
+        });
+    })?;
+    Ok(flag)
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,16 @@
+//! The cosdem application: a job run to its end into a run directory.
+//!
+//! [`run`] is the run driver (the material for a job, the solver, the writer); [`checkpoint`]
+//! saves and restores a run; [`output`] writes the run directory (curve, VTK, summary,
+//! snapshots) and draws its figures; [`rve`] drives one assembly through a laboratory path
+//! (`cosdem rve`, calibration).
+
+/// Checkpoints (`RUN/checkpoint.bin`), resume, and the clean stop on Ctrl-C.
+pub mod checkpoint;
+/// Writing results: VTK unstructured grids, ParaView collections, CSV curves, plots.
+pub mod output;
+/// One job run to its end into a run directory (the library side of `cosdem run`).
+pub mod run;
+/// One DEM assembly driven through a laboratory path (biaxial, isotropic, simple shear):
+/// `cosdem rve`, for calibrating micro parameters.
+pub mod rve;

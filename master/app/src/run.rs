@@ -1,0 +1,167 @@
+//! One job, run to its end into a run directory: the library side of `cosdem run`.
+//!
+//! [`material_for`] turns the job's `[material]` into what answers at the Gauss points (an
+//! analytical material, or a pool of DEM workers holding one assembly per Gauss point);
+//! [`execute`] runs the solver into a [`RunWriter`] and returns the summary. The CLI adds the
+//! progress bar, logging and signal handling on top; batch drivers (the speed/accuracy sweep,
+//! the RVE-size study) call [`run_job`] directly.
+
+use crate::output::run_dir::{RunSettings, RunWriter, Summary};
+use cosdem_common::GaussPointId;
+use cosdem_common::micro::{AssemblyRequest, AssemblyState, BoundaryKind};
+use cosdem_fem::material::Material;
+use cosdem_fem::solve::Solver;
+use cosdem_job::{Job, MaterialSection};
+use cosdem_pool::{Pool, PoolConfig};
+use cosdem_worker::Dem;
+use std::path::Path;
+
+/// Errors of a whole run.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    /// The job, the solver or the output failed.
+    #[error(transparent)]
+    Solver(#[from] cosdem_fem::Error),
+    /// The worker pool could not be built or used.
+    #[error("worker pool: {0}")]
+    Pool(#[from] cosdem_pool::PoolError),
+    /// The run directory could not be written.
+    #[error(transparent)]
+    Output(#[from] crate::output::OutputError),
+    /// The assembly specification could not be encoded.
+    #[error("assembly spec: {0}")]
+    Spec(#[from] serde_json::Error),
+    /// The accuracy target could not be turned into settings.
+    #[error(transparent)]
+    Accuracy(#[from] cosdem_tune::accuracy::AccuracyError),
+}
+
+/// The job to run: `job` itself (unchanged, bit for bit) when it has no `accuracy` key, else
+/// the settings [`cosdem_tune::accuracy::tune`] picks for the target, with its report.
+pub fn tuned(job: &Job) -> Result<(Job, Option<cosdem_tune::accuracy::Report>), RunError> {
+    Ok(match cosdem_tune::accuracy::tune(job)? {
+        None => (job.clone(), None),
+        Some(plan) => (plan.job, Some(plan.report)),
+    })
+}
+
+/// Writes `dir/accuracy.json`: what the accuracy target picked and why.
+pub fn write_accuracy_report(
+    report: &cosdem_tune::accuracy::Report,
+    dir: &Path,
+) -> Result<(), crate::output::OutputError> {
+    crate::output::write_atomic(&dir.join(cosdem_tune::accuracy::FILE), report.to_json().as_bytes())
+}
+
+/// Where the DEM assemblies are solved.
+#[derive(Clone, Debug, Default)]
+pub struct WorkerChoice {
+    /// Remote worker addresses (`host:port`, or a name resolving to several); empty: in-process.
+    pub addresses: Vec<String>,
+    /// Pool settings (token, deadlines, threads of in-process workers).
+    pub config: PoolConfig,
+}
+
+/// The internal length used for the equivalent strain of the job's material (m).
+pub fn internal_length(job: &Job) -> f64 {
+    match &job.material {
+        MaterialSection::Elastic { length, .. } => length.unwrap_or(0.01),
+        MaterialSection::Dem { .. } => 0.01,
+    }
+}
+
+/// The run writer's settings for a job.
+pub fn run_settings(job: &Job) -> RunSettings {
+    RunSettings {
+        title: job.title.clone(),
+        shortening: job.shortening(),
+        load_set: job.loading.load_set.clone(),
+        load_scale: job.load_scale(),
+        vtk_every: job.output.vtk_every,
+        internal_length: internal_length(job),
+        linear_range: job.output.linear_range,
+    }
+}
+
+/// Every Gauss point of the solver's mesh, element-major.
+pub fn gauss_point_ids(solver: &Solver) -> Vec<GaussPointId> {
+    let per_element = solver.gauss().per_element as u32;
+    (0..solver.model().mesh.n_elements() as u32)
+        .flat_map(|e| (0..per_element).map(move |p| GaussPointId::new(e, p)))
+        .collect()
+}
+
+/// What answers at the Gauss points, and how many workers serve it (0 for an analytical
+/// material). A DEM job gets a pool (remote workers when `workers.addresses` is non-empty,
+/// else the job's `[workers] in_process` in-process workers) with one assembly per point.
+///
+/// `saved` (a resume) places those committed states instead of building new assemblies.
+pub fn material_for(
+    job: &Job,
+    workers: &WorkerChoice,
+    ids: &[GaussPointId],
+    saved: Option<Vec<AssemblyState>>,
+) -> Result<(Box<dyn Material>, usize), RunError> {
+    match &job.material {
+        MaterialSection::Elastic { .. } => {
+            let m = job.elastic().expect("an elastic job has an elastic material");
+            Ok((Box::new(m), 0))
+        }
+        MaterialSection::Dem { assembly } => {
+            // `dns:NAME:PORT` (a headless service) is the same as `NAME:PORT`: every address
+            // the name resolves to becomes a worker.
+            let addresses: Vec<String> = workers
+                .addresses
+                .iter()
+                .map(|a| a.strip_prefix("dns:").unwrap_or(a).to_string())
+                .collect();
+            let mut pool = if addresses.is_empty() {
+                Pool::in_process(job.workers.in_process.max(1), workers.config.clone(), |_| Dem)?
+            } else {
+                Pool::connect(&addresses, workers.config.clone())?
+            };
+            let request = AssemblyRequest {
+                spec_json: serde_json::to_vec(assembly)?,
+                boundary: BoundaryKind::Unspecified,
+                disc_count_hint: 0,
+            };
+            match saved {
+                // Resume: the assemblies as committed at the checkpoint.
+                Some(states) => pool.restore_states(states).map_err(cosdem_fem::Error::from)?,
+                None => pool.create_assemblies(ids, &request)?,
+            }
+            let n = pool.live_workers();
+            Ok((Box::new(pool), n))
+        }
+    }
+}
+
+/// Runs `job` into `dir` (created) and returns the final summary and curve. A run that stops
+/// early (a step that cannot be cut further, a failed worker) still returns its summary, with
+/// `status = "failed: ..."` and the steps it finished: the curve so far is what the caller
+/// judges. Only errors before the first step (the job, the pool, the output directory) are
+/// returned as `Err`. A job with `accuracy` runs with the settings [`tuned`] picks, and its
+/// report is written to `dir/accuracy.json` and logged.
+pub fn run_job(
+    job: &Job,
+    dir: &Path,
+    workers: &WorkerChoice,
+) -> Result<(Summary, Vec<(f64, f64)>), RunError> {
+    let (job, report) = tuned(job)?;
+    let job = &job;
+    let mut writer = RunWriter::create(dir, run_settings(job))?;
+    if let Some(report) = &report {
+        write_accuracy_report(report, dir)?;
+        for line in report.lines() {
+            tracing::info!("{line}");
+        }
+    }
+    let mut solver = Solver::new(job.model()?, job.solver_settings()?)?;
+    let ids = gauss_point_ids(&solver);
+    let (mut material, n) = material_for(job, workers, &ids, None)?;
+    writer.set_workers(n);
+    let outcome = solver.run(material.as_mut(), &mut writer);
+    writer.add_uncommitted_dem_steps(solver.uncommitted_dem_steps());
+    writer.finish(outcome.as_ref().map(|_| ()).map_err(|e| e.to_string()))?;
+    Ok((writer.summary().clone(), writer.curve().to_vec()))
+}

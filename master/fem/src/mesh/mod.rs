@@ -1,0 +1,220 @@
+//! The macro mesh: nodes, quadratic quadrilaterals and named node and edge sets.
+//!
+//! Every mesh, structured or read from a file, goes through [`Mesh::from_description`]: the
+//! Gmsh reader only has to fill a [`MeshDescription`].
+
+mod structured;
+pub use structured::MAX_ELEMENTS;
+
+use crate::element::ElementKind;
+use crate::error::{Error, Result};
+use std::collections::{BTreeMap, HashMap};
+
+/// A mesh as a reader produces it: coordinates, element node lists in Gmsh order and named
+/// physical groups. Indices are 0-based.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MeshDescription {
+    /// Node coordinates `[x, y]` (m).
+    pub nodes: Vec<[f64; 2]>,
+    /// Element node lists: 8 (Gmsh type 16) or 9 (type 10) nodes in Gmsh order; all elements
+    /// of one mesh have the same kind.
+    pub elements: Vec<Vec<usize>>,
+    /// Named node groups (Gmsh physical points or any node list).
+    pub node_groups: BTreeMap<String, Vec<usize>>,
+    /// Named boundary edge groups, each edge as its 3-node line `[end, end, middle]` (Gmsh
+    /// type 8 order); orientation does not matter. Their nodes also form a node set of the
+    /// same name.
+    pub edge_groups: BTreeMap<String, Vec<[usize; 3]>>,
+}
+
+/// One element edge on a named boundary.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BoundaryEdge {
+    /// The element the edge belongs to.
+    pub element: usize,
+    /// `[start, end, middle]` nodes, counter-clockwise around the element (so the outward
+    /// normal is the tangent turned clockwise).
+    pub nodes: [usize; 3],
+}
+
+/// The macro mesh.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Mesh {
+    /// Node coordinates `[x, y]` (m).
+    pub nodes: Vec<[f64; 2]>,
+    /// Element family (all elements alike).
+    pub kind: ElementKind,
+    /// Element node lists, `kind.nodes()` entries per element, Gmsh order, counter-clockwise.
+    pub connectivity: Vec<usize>,
+    /// Named node sets (sorted, unique node indices).
+    pub node_sets: BTreeMap<String, Vec<usize>>,
+    /// Named boundary edge sets, for tractions.
+    pub edge_sets: BTreeMap<String, Vec<BoundaryEdge>>,
+}
+
+fn invalid(field: &'static str, value: impl ToString, reason: impl ToString) -> Error {
+    Error::InvalidMesh { field, value: value.to_string(), reason: reason.to_string() }
+}
+
+/// Node permutation that reverses the orientation of a quadratic quad (Gmsh order).
+const FLIP: [usize; 9] = [0, 3, 2, 1, 7, 6, 5, 4, 8];
+
+impl Mesh {
+    /// Builds and checks a mesh from a raw description.
+    ///
+    /// Elements given clockwise are renumbered counter-clockwise; edge groups are matched to
+    /// the element that owns them and oriented counter-clockwise around it.
+    pub fn from_description(desc: MeshDescription) -> Result<Self> {
+        let MeshDescription { nodes, elements, node_groups, edge_groups } = desc;
+        let first = elements.first().ok_or_else(|| invalid("elements", 0, "no elements"))?;
+        let kind = match first.len() {
+            8 => ElementKind::Q8,
+            9 => ElementKind::Q9,
+            n => return Err(invalid("elements[0].len()", n, "expected 8 (Q8) or 9 (Q9) nodes")),
+        };
+        for (i, p) in nodes.iter().enumerate() {
+            if !(p[0].is_finite() && p[1].is_finite()) {
+                return Err(invalid("nodes", i, format!("non-finite coordinates {p:?}")));
+            }
+        }
+        let nn = kind.nodes();
+        let mut connectivity = Vec::with_capacity(elements.len() * nn);
+        for (e, el) in elements.iter().enumerate() {
+            if el.len() != nn {
+                return Err(invalid(
+                    "elements",
+                    e,
+                    format!("{} nodes, mesh is {kind:?}", el.len()),
+                ));
+            }
+            if let Some(&bad) = el.iter().find(|&&n| n >= nodes.len()) {
+                return Err(invalid("elements", e, format!("node {bad} >= {}", nodes.len())));
+            }
+            let c: Vec<[f64; 2]> = el[..4].iter().map(|&n| nodes[n]).collect();
+            let area2 = (0..4)
+                .map(|k| c[k][0] * c[(k + 1) % 4][1] - c[(k + 1) % 4][0] * c[k][1])
+                .sum::<f64>();
+            if area2 == 0.0 || !area2.is_finite() {
+                return Err(invalid("elements", e, "zero area"));
+            }
+            if area2 > 0.0 {
+                connectivity.extend_from_slice(el);
+            } else {
+                connectivity.extend(FLIP[..nn].iter().map(|&k| el[k]));
+            }
+        }
+
+        // Edge lookup: sorted end pair -> (element, local edge).
+        let mut owner: HashMap<(usize, usize), (usize, usize)> = HashMap::new();
+        for e in 0..elements.len() {
+            let el = &connectivity[e * nn..(e + 1) * nn];
+            for (k, ed) in ElementKind::edges().iter().enumerate() {
+                let (a, b) = (el[ed[0]], el[ed[1]]);
+                owner.insert((a.min(b), a.max(b)), (e, k));
+            }
+        }
+        let mut node_sets: BTreeMap<String, Vec<usize>> = BTreeMap::new();
+        for (name, group) in node_groups {
+            if let Some(&bad) = group.iter().find(|&&n| n >= nodes.len()) {
+                return Err(invalid(
+                    "node_groups",
+                    &name,
+                    format!("node {bad} >= {}", nodes.len()),
+                ));
+            }
+            node_sets.entry(name).or_default().extend(group);
+        }
+        let mut edge_sets = BTreeMap::new();
+        for (name, group) in edge_groups {
+            let mut edges = Vec::with_capacity(group.len());
+            for line in group {
+                let (a, b) = (line[0], line[1]);
+                let &(e, k) = owner.get(&(a.min(b), a.max(b))).ok_or_else(|| {
+                    invalid("edge_groups", &name, format!("edge {line:?} is no element edge"))
+                })?;
+                let ed = ElementKind::edges()[k];
+                let el = &connectivity[e * nn..(e + 1) * nn];
+                let oriented = [el[ed[0]], el[ed[1]], el[ed[2]]];
+                if oriented[2] != line[2] {
+                    return Err(invalid(
+                        "edge_groups",
+                        &name,
+                        format!("edge {line:?}: middle node differs from element {e}'s"),
+                    ));
+                }
+                edges.push(BoundaryEdge { element: e, nodes: oriented });
+            }
+            node_sets.entry(name.clone()).or_default().extend(edges.iter().flat_map(|e| e.nodes));
+            edge_sets.insert(name, edges);
+        }
+        for set in node_sets.values_mut() {
+            set.sort_unstable();
+            set.dedup();
+        }
+        Ok(Self { nodes, kind, connectivity, node_sets, edge_sets })
+    }
+
+    /// Number of elements.
+    pub fn n_elements(&self) -> usize {
+        self.connectivity.len() / self.kind.nodes()
+    }
+
+    /// Number of nodes.
+    pub fn n_nodes(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// Node indices of element `e`, Gmsh order.
+    pub fn element_nodes(&self, e: usize) -> &[usize] {
+        let nn = self.kind.nodes();
+        &self.connectivity[e * nn..(e + 1) * nn]
+    }
+
+    /// Node coordinates of element `e`, Gmsh order.
+    pub fn element_coords(&self, e: usize) -> Vec<[f64; 2]> {
+        self.element_nodes(e).iter().map(|&n| self.nodes[n]).collect()
+    }
+
+    /// A named node set.
+    pub fn node_set(&self, name: &str) -> Result<&[usize]> {
+        self.node_sets.get(name).map(Vec::as_slice).ok_or_else(|| Error::UnknownSet {
+            kind: "node",
+            name: name.to_string(),
+            known: self.node_sets.keys().cloned().collect::<Vec<_>>().join(", "),
+        })
+    }
+
+    /// A named boundary edge set.
+    pub fn edge_set(&self, name: &str) -> Result<&[BoundaryEdge]> {
+        self.edge_sets.get(name).map(Vec::as_slice).ok_or_else(|| Error::UnknownSet {
+            kind: "edge",
+            name: name.to_string(),
+            known: self.edge_sets.keys().cloned().collect::<Vec<_>>().join(", "),
+        })
+    }
+}
+
+impl From<crate::gmsh::RawMesh> for MeshDescription {
+    /// A Gmsh mesh as read by [`crate::gmsh`]: quadrilaterals, node groups and 3-node
+    /// boundary lines (edges of other lengths are not boundary edges of quadratic elements
+    /// and are left to the node groups).
+    fn from(raw: crate::gmsh::RawMesh) -> Self {
+        let edge_groups = raw
+            .edge_groups
+            .into_iter()
+            .map(|(name, edges)| {
+                let edges = edges
+                    .into_iter()
+                    .filter_map(|e| <[usize; 3]>::try_from(e.as_slice()).ok())
+                    .collect();
+                (name, edges)
+            })
+            .collect();
+        Self {
+            nodes: raw.nodes,
+            elements: raw.elements.into_iter().map(|e| e.nodes).collect(),
+            node_groups: raw.node_groups,
+            edge_groups,
+        }
+    }
+}

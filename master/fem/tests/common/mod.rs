@@ -1,0 +1,117 @@
+//! Helpers shared by the integration tests: meshes, exact fields, error norms.
+#![allow(dead_code)]
+
+use cosdem_fem::assembly::{Component, Field};
+use cosdem_fem::element::{ElementKind, Quadrature, QuadratureRule, shape_at};
+use cosdem_fem::mesh::Mesh;
+use cosdem_fem::solve::{Dirichlet, Loading, SolutionView};
+
+/// The QuadratureRule of each element family in the tests: Q8 reduced 2x2 (the paper),
+/// Q9 full 3x3.
+pub const ELEMENTS: [(ElementKind, QuadratureRule); 2] =
+    [(ElementKind::Q8, QuadratureRule::Gauss2x2), (ElementKind::Q9, QuadratureRule::Gauss3x3)];
+
+/// A unit square of 3x3 elements whose interior corner nodes are moved by up to 20 % of
+/// the element size (deterministically); edges stay straight: mid-edge nodes at edge
+/// midpoints, Q9 centres at the bilinear centre. So the isoparametric map is bilinear, and
+/// the rules integrate the constant-stress element forces exactly (what the patch test needs).
+pub fn distorted_square(kind: ElementKind) -> Mesh {
+    let mut m = Mesh::rectangle(kind, 1.0, 1.0, 3, 3, [0.0, 0.0]).unwrap();
+    let shifts = [[0.06, -0.04], [-0.05, 0.065], [0.045, 0.05], [-0.06, -0.03]];
+    let mut k = 0;
+    let corners: std::collections::BTreeSet<usize> =
+        (0..m.n_elements()).flat_map(|e| m.element_nodes(e)[..4].to_vec()).collect();
+    for &n in &corners {
+        let [x, y] = m.nodes[n];
+        let interior = x > 1e-9 && x < 1.0 - 1e-9 && y > 1e-9 && y < 1.0 - 1e-9;
+        if interior {
+            m.nodes[n] = [x + shifts[k % 4][0], y + shifts[k % 4][1]];
+            k += 1;
+        }
+    }
+    for e in 0..m.n_elements() {
+        let el = m.element_nodes(e).to_vec();
+        let c: Vec<[f64; 2]> = el[..4].iter().map(|&n| m.nodes[n]).collect();
+        let mid = |a: [f64; 2], b: [f64; 2]| [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0];
+        for (slot, (a, b)) in [(4, (0, 1)), (5, (1, 2)), (6, (2, 3)), (7, (3, 0))] {
+            m.nodes[el[slot]] = mid(c[a], c[b]);
+        }
+        if kind == ElementKind::Q9 {
+            m.nodes[el[8]] = [
+                (c[0][0] + c[1][0] + c[2][0] + c[3][0]) / 4.0,
+                (c[0][1] + c[1][1] + c[2][1] + c[3][1]) / 4.0,
+            ];
+        }
+    }
+    m
+}
+
+/// Every node on the boundary of the unit square gets the exact `(u_x, u_y, w)`.
+pub fn boundary_values(mesh: &Mesh, field: Field, exact: impl Fn([f64; 2]) -> [f64; 3]) -> Loading {
+    let mut loading = Loading::default();
+    let mut boundary: Vec<usize> = ["bottom", "top", "left", "right"]
+        .iter()
+        .flat_map(|s| mesh.node_set(s).unwrap().to_vec())
+        .collect();
+    boundary.sort_unstable();
+    boundary.dedup();
+    for n in boundary {
+        let v = exact(mesh.nodes[n]);
+        loading.nodal_dirichlet.push((n, Component::Ux, v[0]));
+        loading.nodal_dirichlet.push((n, Component::Uy, v[1]));
+        if field == Field::Cosserat {
+            loading.nodal_dirichlet.push((n, Component::W, v[2]));
+        }
+    }
+    loading
+}
+
+/// `component = 0` on the four sides of a rectangle mesh.
+pub fn clamp_all_sides(field: Field) -> Vec<Dirichlet> {
+    let comps: &[Component] = match field {
+        Field::Cosserat => &[Component::Ux, Component::Uy, Component::W],
+        Field::Cauchy => &[Component::Ux, Component::Uy],
+    };
+    ["bottom", "top", "left", "right"]
+        .iter()
+        .flat_map(|s| comps.iter().map(|&c| Dirichlet::new(s, c, 0.0)))
+        .collect()
+}
+
+/// Values, gradient `[d/dx, d/dy]` of the FE field of each component at point `xi` of element `e`.
+pub fn fe_field(
+    view: &SolutionView<'_>,
+    e: usize,
+    xi: [f64; 2],
+) -> ([f64; 2], [[f64; 3]; 3], [[f64; 2]; 3]) {
+    let mesh = view.mesh;
+    let s = shape_at(mesh.kind, e, &mesh.element_coords(e), xi).unwrap();
+    let ndf = view.field.ndf();
+    let mut val = [0.0; 3];
+    let mut grad = [[0.0; 2]; 3];
+    for (a, &n) in mesh.element_nodes(e).iter().enumerate() {
+        for c in 0..ndf {
+            let d = view.dofs[n * ndf + c];
+            val[c] += s.n[a] * d;
+            grad[c][0] += s.grad[a][0] * d;
+            grad[c][1] += s.grad[a][1] * d;
+        }
+    }
+    (s.x, [val, [s.det_j, 0.0, 0.0], [0.0; 3]], grad)
+}
+
+/// Integrates `f(x, fe value, fe gradient)` over the mesh with 4x4 Gauss points per element.
+pub fn integrate(
+    view: &SolutionView<'_>,
+    f: impl Fn([f64; 2], [f64; 3], [[f64; 2]; 3]) -> f64,
+) -> f64 {
+    let q = Quadrature::new(QuadratureRule::Gauss4x4);
+    let mut sum = 0.0;
+    for e in 0..view.mesh.n_elements() {
+        for (p, w) in q.points.iter().zip(&q.weights) {
+            let (x, vj, grad) = fe_field(view, e, *p);
+            sum += w * vj[1][0] * f(x, vj[0], grad);
+        }
+    }
+    sum
+}

@@ -1,0 +1,152 @@
+//! `cosdem-worker`: the DEM worker binary.
+//!
+//! ```text
+//! cosdem-worker listen --listen 0.0.0.0:7700 [--token-file FILE] [--threads N]
+//! cosdem-worker health --addr HOST:PORT
+//! cosdem-worker bench dem [--quick]
+//! ```
+
+use anyhow::Result;
+use clap::{Parser, Subcommand};
+use cosdem_dem::BoundarySpec;
+
+/// The cosdem DEM worker.
+#[derive(Parser, Debug)]
+#[command(name = "cosdem-worker", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Serve DEM assemblies over gRPC until SIGTERM / Ctrl-C.
+    Listen(cosdem_worker::ListenArgs),
+    /// Exit 0 iff the worker at `--addr` reports SERVING (for container health checks).
+    Health {
+        /// `host:port` of the worker.
+        #[arg(long, default_value = "127.0.0.1:7700")]
+        addr: String,
+        /// Seconds to wait for the answer.
+        #[arg(long, default_value_t = 5)]
+        timeout: u64,
+    },
+    /// Benchmarks.
+    Bench {
+        #[command(subcommand)]
+        what: BenchWhat,
+    },
+}
+
+#[derive(Subcommand, Debug)]
+enum BenchWhat {
+    /// DEM kernel throughput and one full relaxation.
+    Dem {
+        /// Fewer steps (a smoke run).
+        #[arg(long)]
+        quick: bool,
+    },
+}
+
+fn main() -> Result<()> {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Listen(args) => listen(args),
+        Command::Health { addr, timeout } => health(&addr, timeout),
+        Command::Bench { what: BenchWhat::Dem { quick } } => bench_dem(quick),
+    }
+}
+
+fn bench_dem(quick: bool) -> Result<()> {
+    let work: f64 = if quick { 2e6 } else { 4e7 };
+    for n in [100usize, 400, 1600, 6400] {
+        let steps = (work / n as f64).max(200.0) as u64;
+        let r = cosdem_dem::bench::rate(n, steps)?;
+        println!("{:>6} discs {:>8} steps {:.3e} particle-steps/s", r.discs, r.steps, r.rate);
+    }
+    // What a switched-off sub-model saves (issue 6, item 3b): the kernel is monomorphized on
+    // "has rolling" (k_r > 0 or c_r > 0) and "has dashpots" (any c > 0).
+    use cosdem_dem::spec::{ContactParams, NormalModel, RollingModel, TangentialModel};
+    let full = ContactParams::default();
+    let laws = [
+        ("full law (rolling k_r = 25, no dashpots)", full.clone()),
+        (
+            "rolling k_r = 0 (coulomb model)",
+            ContactParams {
+                rolling: RollingModel::Coulomb { k_r: 0.0, mu_r: 0.2, c_r: 0.0 },
+                ..full.clone()
+            },
+        ),
+        ("rolling none", ContactParams { rolling: RollingModel::None, ..full.clone() }),
+        (
+            "rolling none, tangential none",
+            ContactParams {
+                rolling: RollingModel::None,
+                tangential: TangentialModel::None,
+                ..full.clone()
+            },
+        ),
+        (
+            "full law + dashpots (c_n = 10)",
+            ContactParams { normal: NormalModel::LinearDashpot { k_n: 6.7e7, c_n: 10.0 }, ..full },
+        ),
+    ];
+    let n = 1600;
+    let steps = (work / n as f64).max(200.0) as u64;
+    for (name, law) in laws {
+        let r = cosdem_dem::bench::rate_with(n, steps, law)?;
+        println!("{:>6} discs {name}: {:.3e} particle-steps/s", r.discs, r.rate);
+    }
+    let (n, steps, conv, wall) = cosdem_dem::bench::relaxation()?;
+    println!(
+        "relaxation 0.0784 m^2 ({n} discs, e_yy = -1e-3): {steps} steps, converged {conv}, {wall:.3} s"
+    );
+    for boundary in [BoundarySpec::default(), BoundarySpec::Periodic] {
+        let (n, wall) = cosdem_dem::bench::random_build(0.28, boundary.clone())?;
+        println!("random packing 0.0784 m^2 ({n} discs, {boundary:?}): built in {wall:.3} s");
+    }
+    Ok(())
+}
+
+fn listen(args: cosdem_worker::ListenArgs) -> Result<()> {
+    use cosdem_worker::{Dem, WorkerConfig, serve, shutdown_signal};
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "info".into()),
+        )
+        .with_writer(std::io::stderr)
+        .init();
+    let config: WorkerConfig = args.try_into()?;
+    let runtime = tokio::runtime::Builder::new_multi_thread().enable_all().build()?;
+    // The signal handlers are installed before the port is bound (see `shutdown_signal`).
+    let shutdown = {
+        let _guard = runtime.enter();
+        shutdown_signal()
+    };
+    runtime.block_on(serve(config, Dem, shutdown))?;
+    Ok(())
+}
+
+fn health(addr: &str, timeout: u64) -> Result<()> {
+    use tonic_health::pb::health_check_response::ServingStatus;
+    use tonic_health::pb::{HealthCheckRequest, health_client::HealthClient};
+    let runtime = tokio::runtime::Builder::new_current_thread().enable_all().build()?;
+    runtime.block_on(async {
+        let uri = format!("http://{addr}");
+        let channel = tonic::transport::Endpoint::from_shared(uri)?
+            .connect_timeout(std::time::Duration::from_secs(timeout))
+            .timeout(std::time::Duration::from_secs(timeout))
+            .connect()
+            .await?;
+        let reply = HealthClient::new(channel)
+            .check(HealthCheckRequest { service: String::new() })
+            .await?
+            .into_inner();
+        anyhow::ensure!(
+            reply.status == ServingStatus::Serving as i32,
+            "worker at {addr} is not serving (status {})",
+            reply.status
+        );
+        Ok(())
+    })
+}
