@@ -15,6 +15,8 @@
 //! reaction of `load_set` over the reduced width, so it is doubled ([`Symmetry::load_scale`]):
 //! for the quarter the default `load_set = "top"` is the horizontal axis, which carries the
 //! same vertical force as the platen.
+//!
+//! [`Symmetry::load_scale`]: crate::symmetry::Symmetry::load_scale
 
 use crate::assembly::{Component, Field};
 use crate::solve::{Dirichlet, Loading};

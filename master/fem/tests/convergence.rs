@@ -9,7 +9,7 @@
 //! points. The measured rates (last refinement) are compared with
 //! `tests/baselines/convergence.txt` within 0.05 and with theory within 0.25 (rates approach
 //! their asymptotic value from above or below by O(h) on such coarse meshes). Regenerate the
-//! baseline with `COSDEM_WRITE_BASELINE=1 cargo test -p cosdem-master --test convergence`.
+//! baseline with `COSDEM_WRITE_BASELINE=1 cargo test -p cosdem-fem --test convergence`.
 
 mod common;
 

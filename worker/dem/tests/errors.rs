@@ -77,7 +77,8 @@ fn bad_bytes_and_unknown_fields() {
     let a = Assembly::new(&hex_spec(0.1, penalty())).unwrap();
     let mut b = a.to_bytes();
     b.truncate(b.len() / 2);
-    assert!(Assembly::from_bytes(&b).is_err());
+    let err = Assembly::from_bytes(&b).unwrap_err();
+    assert!(matches!(err, cosdem_dem::Error::Decode(_)), "{err}");
     let e = serde_json::from_str::<AssemblySpec>(r#"{"densty": 2000}"#).unwrap_err().to_string();
     assert!(e.contains("densty"), "{e}");
     let e = serde_json::from_str::<AssemblySpec>(

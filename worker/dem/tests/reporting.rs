@@ -43,7 +43,14 @@ fn sliding_is_reported_and_softens_the_sliding_aware_tangent() {
     let aware = b.solve(&target).unwrap();
     assert_eq!(paper.stress, aware.stress);
     let f = paper.diagnostics.sliding_fraction;
-    assert!(f > 0.0, "sliding fraction {f}");
+    // Measured: 2 of 184 contacts slide (1.09 %, the "about 1 %" above). Tolerance one
+    // contact: whether a contact right at the Coulomb limit counts as sliding depends on the
+    // last bits of the relaxation path.
+    let contacts = f64::from(paper.diagnostics.contacts);
+    assert!(
+        (f - 2.0 / 184.0).abs() <= 1.0 / contacts + 1e-12,
+        "sliding fraction {f} of {contacts} contacts"
+    );
     assert!(aware.tangent[XY][XY] < paper.tangent[XY][XY]);
     assert!(aware.tangent[YX][YX] < paper.tangent[YX][YX]);
 }

@@ -5,6 +5,10 @@
 //! holds the mapped shape functions of every Gauss point (computed once); [`CosseratOperator`]
 //! is the local assembler (B matrix, element force and stiffness) and [`Pattern`] scatters into
 //! a CSC matrix whose structure is built once.
+//!
+//! [`GaussData`]: crate::assembly::GaussData
+//! [`CosseratOperator`]: crate::assembly::CosseratOperator
+//! [`Pattern`]: crate::assembly::Pattern
 
 mod dofs;
 mod gauss;

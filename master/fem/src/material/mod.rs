@@ -3,6 +3,8 @@
 //! The FE solver talks to its material only through [`Material`]: one batched call per Newton
 //! iteration with every Gauss point's trial kinematics, then `commit` or `rollback`. An
 //! analytical material and the DEM-backed worker pool are both implementations.
+//!
+//! [`Material`]: crate::material::Material
 
 use cosdem_common::micro::AssemblyState;
 use cosdem_common::micro::MicroSnapshot;

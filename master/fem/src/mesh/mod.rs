@@ -2,6 +2,9 @@
 //!
 //! Every mesh, structured or read from a file, goes through [`Mesh::from_description`]: the
 //! Gmsh reader only has to fill a [`MeshDescription`].
+//!
+//! [`Mesh::from_description`]: crate::mesh::Mesh::from_description
+//! [`MeshDescription`]: crate::mesh::MeshDescription
 
 mod structured;
 pub use structured::MAX_ELEMENTS;

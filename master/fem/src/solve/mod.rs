@@ -6,13 +6,15 @@ mod loading;
 mod newton;
 mod observer;
 pub mod secant;
+mod settings;
+mod solver;
+mod system;
 
 pub use linear::LinearSolver;
 pub use loading::{
     BodyLoad, Dirichlet, EdgeLoad, EdgeLoadKind, LoadVectors, Loading, Platens, Ramp,
 };
-pub use newton::{
-    IterationTiming, MAX_LOAD_STEPS, MIN_INCREMENT_FRACTION, Model, RunSummary, Solver,
-    SolverSettings, SolverState,
-};
 pub use observer::{GaussPointState, SolutionView, StepControl, StepObserver, StepReport};
+pub use settings::{MAX_LOAD_STEPS, MIN_INCREMENT_FRACTION, SolverSettings};
+pub use solver::{Model, RunSummary, Solver, SolverState};
+pub use system::IterationTiming;

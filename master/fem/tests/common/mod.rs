@@ -1,6 +1,8 @@
 //! Helpers shared by the integration tests: meshes, exact fields, error norms.
 #![allow(dead_code)]
 
+pub mod panel;
+
 use cosdem_fem::assembly::{Component, Field};
 use cosdem_fem::element::{ElementKind, Quadrature, QuadratureRule, shape_at};
 use cosdem_fem::mesh::Mesh;

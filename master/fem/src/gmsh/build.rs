@@ -1,0 +1,194 @@
+//! From the records of any format to a [`RawMesh`]: duplicate elements of format 2.2 merged,
+//! nodes checked and renumbered, quadrilaterals oriented counter-clockwise, and the points and
+//! lines of physical groups turned into node and edge groups.
+
+use super::records::{ElemRec, NodeRec, type_info};
+use super::{GmshError, QuadKind, RawElement, RawMesh, Result, structure};
+use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
+
+/// Signed area of the corner polygon of a quadrilateral.
+pub(super) fn corner_area(c: [[f64; 2]; 4]) -> f64 {
+    let mut a = 0.0;
+    for i in 0..4 {
+        let [x0, y0] = c[i];
+        let [x1, y1] = c[(i + 1) % 4];
+        a += x0 * y1 - x1 * y0;
+    }
+    0.5 * a
+}
+
+/// Node permutation that mirrors a clockwise quadrilateral into a counter-clockwise one.
+const MIRROR: [usize; 9] = [0, 3, 2, 1, 7, 6, 5, 4, 8];
+
+/// Checks the records against each other and builds the [`RawMesh`]: duplicate nodes and
+/// element tags, node counts per type, unknown node tags and degenerate quadrilaterals are
+/// errors.
+pub(super) fn assemble(
+    file: &str,
+    physical_names: BTreeMap<(u32, i32), String>,
+    nodes: Vec<(NodeRec, usize)>,
+    elements: Vec<ElemRec>,
+) -> Result<RawMesh> {
+    let mut by_tag: HashMap<u64, [f64; 2]> = HashMap::with_capacity(nodes.len());
+    for (n, line) in &nodes {
+        if by_tag.insert(n.tag, n.xy).is_some() {
+            return Err(GmshError::Syntax {
+                file: file.to_string(),
+                line: *line,
+                message: format!("node tag {} is defined twice", n.tag),
+            });
+        }
+    }
+    let group_name = |dim: u32, tag: i32| -> String {
+        physical_names
+            .get(&(dim, tag))
+            .or_else(|| physical_names.get(&(dim, tag.abs())))
+            .cloned()
+            .unwrap_or_else(|| tag.to_string())
+    };
+
+    // Format 2.2 repeats an element, under a new tag, once per physical group it belongs to:
+    // an element is identified by its type and nodes, and keeps its first tag.
+    // Quadrilaterals by element tag.
+    let mut quads: BTreeMap<u64, (QuadKind, Vec<u64>, Option<String>, usize)> = BTreeMap::new();
+    let mut quad_seen: HashSet<(u32, Vec<u64>)> = HashSet::new();
+    // Group name -> element tag -> (gmsh type, node tags), and the elements already in it.
+    let mut groups: BTreeMap<String, BTreeMap<u64, (u32, Vec<u64>)>> = BTreeMap::new();
+    let mut group_seen: HashSet<(String, u32, Vec<u64>)> = HashSet::new();
+
+    for e in elements {
+        let info = type_info(e.gmsh_type);
+        let unsupported = || GmshError::UnsupportedElement {
+            file: file.to_string(),
+            line: e.line,
+            element: e.tag,
+            element_type: e.gmsh_type,
+            name: info.map_or("unknown type", |i| i.0),
+        };
+        if let Some((name, _, count)) = info
+            && e.nodes.len() != count
+        {
+            return Err(GmshError::Syntax {
+                file: file.to_string(),
+                line: e.line,
+                message: format!(
+                    "element {} of type {} ({name}) has {} nodes, expected {count}",
+                    e.tag,
+                    e.gmsh_type,
+                    e.nodes.len()
+                ),
+            });
+        }
+        for &n in &e.nodes {
+            if !by_tag.contains_key(&n) {
+                return Err(GmshError::UnknownNode {
+                    file: file.to_string(),
+                    line: e.line,
+                    element: e.tag,
+                    node: n,
+                });
+            }
+        }
+        if let Some(kind) = QuadKind::from_gmsh_type(e.gmsh_type) {
+            let physical = e.physicals.first().map(|&p| group_name(2, p));
+            if !quad_seen.insert((e.gmsh_type, e.nodes.clone())) {
+                continue;
+            }
+            if quads.contains_key(&e.tag) {
+                return Err(GmshError::Syntax {
+                    file: file.to_string(),
+                    line: e.line,
+                    message: format!("element tag {} is used twice", e.tag),
+                });
+            }
+            quads.insert(e.tag, (kind, e.nodes, physical, e.line));
+            continue;
+        }
+        match (e.dim, e.gmsh_type) {
+            (Some(0 | 1), 1 | 8 | 15) => {
+                let dim = e.dim.unwrap_or(1);
+                for &p in &e.physicals {
+                    let name = group_name(dim, p);
+                    if group_seen.insert((name.clone(), e.gmsh_type, e.nodes.clone())) {
+                        groups
+                            .entry(name)
+                            .or_default()
+                            .insert(e.tag, (e.gmsh_type, e.nodes.clone()));
+                    }
+                }
+            }
+            (Some(0 | 1), _) if e.physicals.is_empty() => {}
+            _ => return Err(unsupported()),
+        }
+    }
+    if quads.is_empty() {
+        return Err(structure(
+            file,
+            "no 8-node (type 16) or 9-node (type 10) quadrilaterals: mesh with `-order 2` \
+             and recombine the surfaces",
+        ));
+    }
+
+    // Renumber the used nodes by increasing tag.
+    let mut used: BTreeSet<u64> = BTreeSet::new();
+    for (_, nodes, _, _) in quads.values() {
+        used.extend(nodes.iter().copied());
+    }
+    for g in groups.values() {
+        for (_, nodes) in g.values() {
+            used.extend(nodes.iter().copied());
+        }
+    }
+    let index: HashMap<u64, usize> = used.iter().enumerate().map(|(i, &t)| (t, i)).collect();
+    let mesh_nodes: Vec<[f64; 2]> = used.iter().map(|t| by_tag[t]).collect();
+
+    let mut out_elements = Vec::with_capacity(quads.len());
+    for (tag, (kind, tags, physical, line)) in quads {
+        let mut nodes: Vec<usize> = tags.iter().map(|t| index[t]).collect();
+        let corners = [0, 1, 2, 3].map(|i| mesh_nodes[nodes[i]]);
+        let area = corner_area(corners);
+        let mut size: f64 = 0.0;
+        for i in 0..4 {
+            let (a, b) = (corners[i], corners[(i + 1) % 4]);
+            size = size.max((b[0] - a[0]).hypot(b[1] - a[1]));
+        }
+        if !area.is_finite() || area.abs() <= 1e-12 * size * size {
+            return Err(GmshError::DegenerateElement {
+                file: file.to_string(),
+                line,
+                element: tag,
+                area,
+            });
+        }
+        if area < 0.0 {
+            nodes = (0..kind.node_count()).map(|i| nodes[MIRROR[i]]).collect();
+        }
+        out_elements.push(RawElement { kind, nodes, physical });
+    }
+
+    let mut node_groups = BTreeMap::new();
+    let mut edge_groups = BTreeMap::new();
+    for (name, elems) in groups {
+        let mut set = BTreeSet::new();
+        let mut edges = Vec::new();
+        for (gmsh_type, tags) in elems.into_values() {
+            let idx: Vec<usize> = tags.iter().map(|t| index[t]).collect();
+            set.extend(idx.iter().copied());
+            if gmsh_type == 8 {
+                edges.push(idx);
+            }
+        }
+        node_groups.insert(name.clone(), set.into_iter().collect());
+        if !edges.is_empty() {
+            edge_groups.insert(name, edges);
+        }
+    }
+
+    Ok(RawMesh {
+        nodes: mesh_nodes,
+        elements: out_elements,
+        physical_names,
+        node_groups,
+        edge_groups,
+    })
+}

@@ -1,0 +1,69 @@
+//! The tangent operator an assembly returns with its stress.
+
+use crate::error::{Result, invalid, positive};
+use serde::{Deserialize, Serialize};
+
+/// Tangent operator returned by `solve`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, Default)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum TangentKind {
+    /// The paper's contact-stiffness tangent (k_s, k_r on every active contact).
+    #[default]
+    #[serde(deserialize_with = "super::no_settings")]
+    Paper,
+    /// As `Paper` but `k_s' = 0` on sliding and `k_r' = 0` on saturated rolling contacts.
+    #[serde(deserialize_with = "super::no_settings")]
+    SlidingAware,
+    /// `Paper` scaled by the assembly's secant ratio since its committed state: `s = (dsigma
+    /// . de) / (de . C de)` with `de` the strain (and curvature) increment from the committed
+    /// target, `dsigma` the stress (and couple stress) increment from the committed relaxed
+    /// answer and `C` the paper tangent, kept in [`SECANT_RANGE`]. The contact tangent
+    /// assumes affine motion and sticking contacts, an upper bound the relaxed random
+    /// assembly falls below (its contacts slide, its discs move non-affinely); the secant
+    /// measures by how much along the step's own path. `s = 1` (the paper tangent) when the
+    /// committed state was never relaxed, the increment is nil, or its second-order work is
+    /// not positive (`dsigma . de <= 0`, softening past a peak: no positive scale helps
+    /// there). Deterministic: it depends on the committed state and the trial only.
+    #[serde(deserialize_with = "super::no_settings")]
+    Secant,
+    /// Central differences of extra relaxations from the trial state, which is restored.
+    Perturbation {
+        /// Strain perturbation (default 1e-5 in the job file; must be > 0).
+        strain: f64,
+    },
+    /// `Paper` while fewer than `sliding` of the assembly's contacts slide, `Perturbation`
+    /// from there on: the contact-stiffness tangent is right while the contacts stick and too
+    /// stiff once the assembly slips and softens, where the perturbation tangent follows it.
+    /// Only the sliding assemblies pay the twelve extra relaxations (scene B: the band, not
+    /// the 400 points). The choice depends on the assembly's own relaxed state only, so it is
+    /// the same whatever worker holds the assembly.
+    Adaptive {
+        /// Sliding fraction (sliding contacts / contacts) from which the perturbation tangent
+        /// is used, in [0, 1].
+        sliding: f64,
+        /// Strain perturbation of the perturbation tangent (> 0).
+        strain: f64,
+    },
+}
+
+/// The range of the [`TangentKind::Secant`] scale: never stiffer than the contact tangent,
+/// never softer than a twentieth of it (a near-zero secant would hand Newton a singular
+/// matrix).
+pub const SECANT_RANGE: (f64, f64) = (0.05, 1.0);
+
+impl TangentKind {
+    /// Checks the perturbation strain and the sliding fraction.
+    pub(super) fn validate(&self) -> Result<()> {
+        match self {
+            TangentKind::Perturbation { strain } => positive("tangent.strain", *strain)?,
+            TangentKind::Adaptive { sliding, strain } => {
+                positive("tangent.strain", *strain)?;
+                if !(0.0..=1.0).contains(sliding) {
+                    return Err(invalid("tangent.sliding", sliding, "must be in [0, 1]"));
+                }
+            }
+            TangentKind::Paper | TangentKind::SlidingAware | TangentKind::Secant => {}
+        }
+        Ok(())
+    }
+}
