@@ -1,12 +1,12 @@
 //! The accuracy target keeps its promise on a scene the measured table was not made on.
 //!
-//! The table (`docs/notes/tradeoff-scene-a.csv`) is scene A: a 1 x 1 m panel, 2 x 2 elements,
-//! 100 kPa confinement, 105-disc assemblies (V = 0.01 m^2), 2 mm load steps to 0.03 m. The
-//! scene here differs in every one of those: a slender 0.5 x 1 m panel (aspect 2) of 1 x 2
-//! elements, 150 kPa confinement, smaller assemblies (side 0.08 m, V = 0.0064 m^2), to
-//! 0.012 m (pre-peak, like the table). It runs once with `accuracy = 0.05` (the settings
+//! The table (`master/tune/data/tradeoff-scene-a.csv`) is scene A: a 1 x 1 m panel, 2 x 2
+//! elements, 100 kPa confinement, 105-disc assemblies (V = 0.01 m^2), 2 mm load steps to
+//! 0.03 m. The scene here differs in every one of those: a slender 0.5 x 1 m panel (aspect 2)
+//! of 1 x 2 elements, 150 kPa confinement, smaller assemblies (side 0.08 m, V = 0.0064 m^2),
+//! to 0.012 m (pre-peak, like the table). It runs once with `accuracy = 0.05` (the settings
 //! `cosdem run` would pick) and once with the sweep's tight reference settings
-//! (`tradeoff::reference`: relaxation tolerance 1e-5, safety 0.25, half the load step, cold
+//! ([`reference`]: relaxation tolerance 1e-5, safety 0.25, half the load step, cold
 //! starts), and checks:
 //!
 //! - F_u and E of the accuracy run are within 5 % of the reference's (and F_res, if the
@@ -71,8 +71,9 @@ fn accuracy_target_holds_on_a_scene_the_table_was_not_measured_on() {
 }
 
 /// The same scene with random polydisperse assemblies (radii 4-6 mm, equilibrated at
-/// 150 kPa, a penalty boundary): planned from the random table (`docs/notes/tradeoff-biaxial-1mm.csv`:
-/// periodic 2-3 mm assemblies, smooth platens, 100 kPa), which this scene differs from in
+/// 150 kPa, a penalty boundary): planned from the random table
+/// (`master/tune/data/tradeoff-biaxial-1mm.csv`: periodic 2-3 mm assemblies, smooth platens,
+/// 100 kPa), which this scene differs from in
 /// radii, boundary, platens, confinement and mesh. Its default is 2.9 % from its reference
 /// (the half load step), so only a 10 % target moves knobs; the promise is checked at 10 %.
 /// (Before the specimen was fixed across the knobs, this scene's default settings alone

@@ -227,8 +227,8 @@ fn write_tables(
 pub const CHECKED_TARGETS: [f64; 3] = [0.05, 0.1, 0.2];
 
 /// The combination rows of a sweep of `base` from its one-knob `rows` (see [`sweep`]):
-/// planned with [`cosdem_tune::accuracy::plan`] and [`cosdem_tune::accuracy::cheapest`] from a trade
-/// whose default is `base` itself. None for an analytical material, or when the reference or
+/// planned with [`cosdem_tune::accuracy::plan`] and [`cosdem_tune::accuracy::cheapest`] from a
+/// trade whose default is `base` itself. None for an analytical material, or when the reference or
 /// the default did not finish (there is no trade to plan from).
 pub fn combinations(base: &Job, rows: &[Row]) -> Result<Vec<Variant>, cosdem_app::run::RunError> {
     use cosdem_tune::accuracy::{Trade, cheapest, packing_kind, plan};
@@ -267,7 +267,7 @@ pub fn combinations(base: &Job, rows: &[Row]) -> Result<Vec<Variant>, cosdem_app
 #[cfg(test)]
 mod tests {
     use super::*;
-    use cosdem_dem::spec::{Driver, PackingSpec, TangentKind};
+    use cosdem_dem::spec::{Driver, TangentKind};
 
     /// A curve compared with itself has zero error; a curve scaled by (1 + a) has relative
     /// L2 error exactly a (up to round-off), whatever the steps it was sampled at.
@@ -454,32 +454,6 @@ mod tests {
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
-    /// `apply_setting` makes the same job as the sweep's variant of that setting.
-    #[test]
-    fn apply_setting_agrees_with_the_variants() {
-        let job =
-            Job::from_toml(include_str!("../../../examples/quick.toml"), "examples/quick.toml")
-                .unwrap();
-        let side = |j: &mut Job| match &mut assembly_mut(j).unwrap().packing {
-            PackingSpec::Hexagonal { side, .. } | PackingSpec::Random { side, .. } => {
-                std::mem::replace(side, 0.0)
-            }
-        };
-        for v in &variants(&job)[2..] {
-            let mut j = job.clone();
-            apply_setting(&mut j, v.knob, &v.setting).unwrap();
-            let mut expect = v.job.clone();
-            // The side is printed to 3 decimals in the setting (0.1 * 0.75 = 0.07500000000000001).
-            let (a, b) = (side(&mut j), side(&mut expect));
-            assert!((a - b).abs() <= 5e-4, "{}: side {a} vs {b}", v.slug());
-            assert_eq!(j, expect, "{}", v.slug());
-        }
-        let mut j = job.clone();
-        assert!(apply_setting(&mut j, "tangent", "magic").is_err());
-        assert!(apply_setting(&mut j, "load_step", "x0").is_err());
-        assert!(apply_setting(&mut j, "relaxation.tolerance", "-1").is_err());
-    }
-
     /// Metric errors are relative and missing values stay missing.
     #[test]
     fn compare_metrics() {
@@ -522,88 +496,6 @@ mod tests {
         let longer = [reference.to_vec(), vec![(5e-3, 60.0)]].concat();
         let e = compare((&rm, &longer), (&m, &run));
         assert!((e.residual.unwrap() - 1.0 / 3.0).abs() < 1e-15);
-    }
-
-    /// `--skip` names a variant by knob or by knob=setting, nothing else.
-    #[test]
-    fn skip_by_knob_or_setting() {
-        let job =
-            Job::from_toml(include_str!("../../../examples/quick.toml"), "examples/quick.toml")
-                .unwrap();
-        let v = variants(&job);
-        let fire = v.iter().find(|v| v.setting == "fire").unwrap();
-        let x2 = v.iter().find(|v| v.knob == "load_step" && v.setting == "x2").unwrap();
-        let by_knob = ["relaxation.driver".to_string()];
-        assert!(skipped(fire, &by_knob) && !skipped(x2, &by_knob));
-        let by_setting = ["load_step=x4".to_string()];
-        assert!(!skipped(x2, &by_setting));
-        assert!(v.iter().any(|v| skipped(v, &by_setting)));
-        assert!(!skipped(fire, &[]));
-    }
-
-    /// The sweep of a DEM job moves one knob at a time and keeps the scene.
-    #[test]
-    fn variants_move_one_knob() {
-        let job =
-            Job::from_toml(include_str!("../../../examples/quick.toml"), "examples/quick.toml")
-                .unwrap();
-        let v = variants(&job);
-        assert_eq!(v[0].knob, "reference");
-        assert_eq!(v[1].job, job);
-        let knobs: std::collections::BTreeSet<_> = v.iter().map(|v| v.knob).collect();
-        for k in [
-            "load_step",
-            "relaxation.tolerance",
-            "relaxation.safety",
-            "relaxation.density_scale",
-            "relaxation.driver",
-            "tangent",
-            "warm_start",
-            "relaxation.skip_below",
-            "relaxation.elastic_shortcut",
-            "relaxation.substep",
-            "newton.secant_updates",
-            "newton.stall_iterations",
-            "assembly.side",
-        ] {
-            assert!(knobs.contains(k), "{k} missing");
-        }
-        for x in &v[2..] {
-            assert_eq!(x.job.mesh, job.mesh, "{}", x.slug());
-            assert_ne!(x.job, job, "{} changes nothing", x.slug());
-        }
-        let slugs: std::collections::BTreeSet<_> = v.iter().map(Variant::slug).collect();
-        assert_eq!(slugs.len(), v.len(), "slugs must be unique (run directories)");
-        // The load-path row takes the reference's step with the job's relaxation.
-        let half = v.iter().find(|v| v.knob == "load_step" && v.setting == "x0.5").unwrap();
-        assert_eq!(half.job.loading.increment, Some(0.001));
-        assert_eq!(half.job.loading.increment, v[0].job.loading.increment);
-        assert_eq!(half.job.material, job.material);
-    }
-
-    /// A job that already sets a sweep's setting (tolerance 1e-3, mass scaling 4, FIRE, warm
-    /// start) gets no row for it: the row would be the default run again, at its full cost.
-    #[test]
-    fn a_setting_the_job_has_is_not_swept_again() {
-        let mut job =
-            Job::from_toml(include_str!("../../../examples/quick.toml"), "examples/quick.toml")
-                .unwrap();
-        let a = assembly_mut(&mut job).unwrap();
-        a.relaxation.tolerance = 1e-3;
-        a.relaxation.density_scale = 4.0;
-        a.relaxation.driver = Driver::fire();
-        a.warm_start = true;
-        let v = variants(&job);
-        for x in &v[2..] {
-            assert_ne!(x.job, job, "{} repeats the default", x.slug());
-        }
-        let settings: Vec<_> = v.iter().map(Variant::slug).collect();
-        for kept in ["relaxation.tolerance_3e-4", "relaxation.density_scale_16"] {
-            assert!(settings.iter().any(|s| s == kept), "{kept} missing: {settings:?}");
-        }
-        for gone in ["relaxation.driver", "warm_start"] {
-            assert!(!settings.iter().any(|s| s.starts_with(gone)), "{gone}: {settings:?}");
-        }
     }
 
     /// The combination rows of a sweep are planned from the sweep's own rows, with the job

@@ -6,7 +6,7 @@
 /// Accuracy target: the cheapest speed settings the measured trade predicts to stay within
 /// a job's `accuracy` (what was picked and why: `RUN/accuracy.json`).
 pub mod accuracy;
-/// The speed knobs: the sweep's variants and the moves a table row names.
+/// The speed knobs: [`knob::Knob`], their one catalogue, and the sweep built from it.
 pub mod knob;
 /// The trade table: rows, errors against a reference, Pareto front, CSV and Markdown.
 pub mod table;

@@ -185,8 +185,7 @@ fn pct(e: Option<f64>) -> String {
     e.map_or("-".into(), |e| format!("{:.2} %", 100.0 * e))
 }
 
-/// Whether `--skip` names the variant: by its knob (`relaxation.driver`) or its knob and
-
+/// The Markdown table of a sweep (rows in sweep order; Pareto-front rows marked with `*`).
 pub fn markdown(title: &str, rows: &[Row]) -> String {
     let front = pareto_front(rows);
     let mut s = format!(
@@ -254,7 +253,13 @@ pub enum TableError {
         /// What is wrong, naming the line and the column.
         message: String,
     },
-    /// A (knob, setting) pair that [`apply_setting`] does not know.
+    /// A name that is no speed knob (see [`crate::knob::Knob::ALL`]).
+    #[error("unknown knob {knob}")]
+    UnknownKnob {
+        /// The name.
+        knob: String,
+    },
+    /// A setting that [`crate::knob::Knob::apply`] does not know for its knob.
     #[error("unknown setting {knob} = {setting}")]
     UnknownSetting {
         /// The knob.
