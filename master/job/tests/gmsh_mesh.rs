@@ -1,7 +1,7 @@
 //! A Gmsh file written by Gmsh gives the same answer as the structured mesh of the same
-//! geometry: the 1 x 1 m square, 2 x 2 Q8 (`tests/data/square_q8.geo`, meshed by Gmsh 4.8.4)
-//! and 3 x 2 Q9, compressed between rough platens with a pressure on the left edge, elastic
-//! Cosserat material.
+//! geometry: the 1 x 1 m square, 2 x 2 Q8 (`master/fem/tests/data/square_q8.geo`, meshed by
+//! Gmsh 4.8.4) and 3 x 2 Q9, compressed between rough platens with a pressure on the left edge,
+//! elastic Cosserat material: the job of the fixture `gmsh-square`, on each mesh.
 //!
 //! Node and element numbering differ between the two meshes, so the comparison is of
 //! numbering-free quantities: the reactions of the named sets and the Gauss-point stresses
@@ -9,9 +9,8 @@
 //! to round-off of the linear solves (1e-9 relative, far above 1e-16 times the condition number
 //! of these 100-dof systems, far below any discretization error).
 
-use cosdem_fem::material::ElasticCosserat;
 use cosdem_fem::solve::{SolutionView, Solver, StepObserver, StepReport};
-use cosdem_job::Job;
+use cosdem_job::{Integration, Job, fixtures};
 
 #[derive(Default)]
 struct Last {
@@ -27,33 +26,27 @@ impl StepObserver for Last {
     }
 }
 
-fn run(mesh_table: &str) -> Last {
-    let text = format!(
-        r#"
-        [mesh]
-        {mesh_table}
-        [loading]
-        steps = 2
-        [loading.compression]
-        displacement = 0.002
-        [[loading.pressure]]
-        set = "left"
-        value = 5e4
-        [material]
-        kind = "elastic"
-        shear_modulus = 1e7
-        poisson = 0.25
-        length = 0.05
-        "#
-    );
-    let mut job = Job::from_toml(&text, "inline").unwrap();
-    if let Some(f) = &job.mesh.file {
-        // The committed test meshes are the FE core's.
-        job.mesh.file =
-            Some(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../fem").join(f));
-    }
+/// The `gmsh-square` fixture on the Gmsh file `file` (beside the fixture's own) with the
+/// Gauss rule `integration`.
+fn gmsh(file: &str, integration: Integration) -> Job {
+    let mut job = fixtures::load("gmsh-square");
+    job.mesh.file = job.mesh.file.map(|f| f.with_file_name(file));
+    job.mesh.integration = integration;
+    job.validate().unwrap();
+    job
+}
+
+/// The `gmsh-square` fixture on the structured mesh of the `[mesh]` table `mesh`.
+fn structured(mesh: &str) -> Job {
+    let mut job = fixtures::load("gmsh-square");
+    job.mesh = toml::from_str(mesh).unwrap();
+    job.validate().unwrap();
+    job
+}
+
+fn run(job: &Job) -> Last {
     let mut solver = Solver::new(job.model().unwrap(), job.solver_settings().unwrap()).unwrap();
-    let mut material = ElasticCosserat::new(1e7, 0.25, 5e6, 0.05);
+    let mut material = job.elastic().unwrap();
     let mut last = Last::default();
     solver.run(&mut material, &mut last).unwrap();
     last
@@ -84,19 +77,16 @@ fn compare(a: &Last, b: &Last) {
 
 #[test]
 fn gmsh_q8_square_matches_the_structured_mesh() {
-    let structured = run("kind = \"rectangle\"\nlx = 1.0\nly = 1.0\nnx = 2\nny = 2");
+    let structured = run(&structured("kind = \"rectangle\"\nlx = 1.0\nly = 1.0\nnx = 2\nny = 2"));
     for file in ["square_q8_v22.msh", "square_q8_v41.msh", "square_q8_v41_bin.msh"] {
-        let gmsh = run(&format!("kind = \"gmsh\"\nfile = \"tests/data/{file}\""));
-        compare(&structured, &gmsh);
+        compare(&structured, &run(&gmsh(file, Integration::Reduced)));
     }
 }
 
 #[test]
 fn gmsh_q9_square_matches_the_structured_mesh() {
-    let structured = run(
+    let structured = run(&structured(
         "kind = \"rectangle\"\nlx = 1.0\nly = 1.0\nnx = 3\nny = 2\nelement = \"q9\"\nintegration = \"full\"",
-    );
-    let gmsh =
-        run("kind = \"gmsh\"\nfile = \"tests/data/square_q9_v41.msh\"\nintegration = \"full\"");
-    compare(&structured, &gmsh);
+    ));
+    compare(&structured, &run(&gmsh("square_q9_v41.msh", Integration::Full)));
 }

@@ -1,0 +1,210 @@
+//! From the job to the solver's own types: the FE [`Model`](cosdem_fem::solve::Model) (mesh, field, Gauss rule,
+//! loading), the [`SolverSettings`] and the elastic material. Nothing past this module knows
+//! about the job file.
+
+use crate::schema::{
+    ComponentChoice, Continuum, ElementChoice, Integration, Job, MaterialSection, MeshKind, Moving,
+    PlatenChoice, RampChoice,
+};
+use cosdem_fem::assembly::{Component, Field};
+use cosdem_fem::element::{ElementKind, QuadratureRule};
+use cosdem_fem::error::{Error, Result};
+use cosdem_fem::gmsh;
+use cosdem_fem::material::ElasticCosserat;
+use cosdem_fem::mesh::{Mesh, MeshDescription};
+use cosdem_fem::solve::{
+    Dirichlet, EdgeLoad, EdgeLoadKind, Loading, Platens, Ramp, SolverSettings,
+};
+use std::path::Path;
+
+impl From<ComponentChoice> for Component {
+    fn from(c: ComponentChoice) -> Self {
+        match c {
+            ComponentChoice::Ux => Component::Ux,
+            ComponentChoice::Uy => Component::Uy,
+            ComponentChoice::W => Component::W,
+        }
+    }
+}
+
+impl Job {
+    /// The linear-elastic Cosserat material of an `elastic` job (its defaults filled in:
+    /// Gc = G / 2, lc = 0.01 m); `None` for a DEM job.
+    pub fn elastic(&self) -> Option<ElasticCosserat> {
+        match &self.material {
+            MaterialSection::Elastic { shear_modulus, poisson, cosserat_modulus, length } => {
+                let g = *shear_modulus;
+                Some(ElasticCosserat::new(
+                    g,
+                    *poisson,
+                    cosserat_modulus.unwrap_or(0.5 * g),
+                    length.unwrap_or(0.01),
+                ))
+            }
+            MaterialSection::Dem { .. } => None,
+        }
+    }
+
+    /// The continuum field.
+    pub fn field(&self) -> Field {
+        match self.mesh.continuum {
+            Continuum::Cosserat => Field::Cosserat,
+            Continuum::Cauchy => Field::Cauchy,
+        }
+    }
+
+    /// Builds the mesh (reads the Gmsh file if any).
+    pub fn build_mesh(&self) -> Result<Mesh> {
+        let m = &self.mesh;
+        match m.kind {
+            MeshKind::Rectangle => {
+                let kind = match m.element {
+                    ElementChoice::Q8 => ElementKind::Q8,
+                    ElementChoice::Q9 => ElementKind::Q9,
+                };
+                // validate() made sure these are present.
+                let (lx, ly, nx, ny) = m.symmetry.reduce_rectangle(
+                    m.lx.unwrap_or(1.0),
+                    m.ly.unwrap_or(1.0),
+                    m.nx.unwrap_or(1),
+                    m.ny.unwrap_or(1),
+                );
+                Mesh::rectangle(kind, lx, ly, nx, ny, m.origin)
+            }
+            MeshKind::Gmsh => {
+                let file = m.file.as_deref().unwrap_or(Path::new(""));
+                let raw = gmsh::read_msh(file).map_err(|e| Error::JobFile {
+                    file: file.display().to_string(),
+                    message: e.to_string(),
+                })?;
+                Mesh::from_description(MeshDescription::from(raw))
+            }
+        }
+    }
+
+    /// The loading of the job: compression platens, prescribed dofs and pressures.
+    pub fn loading(&self) -> Loading {
+        let l = &self.loading;
+        let mut loading = match &l.compression {
+            Some(c) => {
+                let platens = match c.platens {
+                    PlatenChoice::Rough => Platens::Rough,
+                    PlatenChoice::Smooth => Platens::Smooth,
+                };
+                let (top, bottom) = match c.moving {
+                    Moving::Both => (-0.5 * c.displacement, 0.5 * c.displacement),
+                    Moving::Top => (-c.displacement, 0.0),
+                };
+                Loading::compression(top, bottom, platens)
+            }
+            None => Loading::default(),
+        };
+        for p in &l.prescribed {
+            loading.dirichlet.push(Dirichlet::new(&p.set, p.component.into(), p.value));
+        }
+        for p in &l.pressure {
+            let ramp = match p.ramp {
+                RampChoice::Constant => Ramp::Constant,
+                RampChoice::Linear => Ramp::Linear,
+            };
+            loading.edge_loads.push(EdgeLoad {
+                set: p.set.clone(),
+                kind: EdgeLoadKind::Pressure(p.value),
+                ramp,
+            });
+        }
+        self.mesh.symmetry.reduce_loading(loading, self.field())
+    }
+
+    /// Factor from the meshed part's reaction to the whole panel's load (2 on a half or
+    /// quarter mesh).
+    pub fn load_scale(&self) -> f64 {
+        self.mesh.symmetry.load_scale()
+    }
+
+    /// Total shortening of the compression (m), 0 without one: the curve's abscissa is
+    /// `load_factor * shortening`.
+    pub fn shortening(&self) -> f64 {
+        self.loading.compression.as_ref().map_or(0.0, |c| c.displacement)
+    }
+
+    /// The Gauss rule.
+    pub fn rule(&self) -> QuadratureRule {
+        match self.mesh.integration {
+            Integration::Reduced => QuadratureRule::Gauss2x2,
+            Integration::Full => QuadratureRule::Gauss3x3,
+        }
+    }
+
+    /// The FE model: mesh, field, rule, loading.
+    pub fn model(&self) -> Result<cosdem_fem::solve::Model> {
+        Ok(cosdem_fem::solve::Model {
+            mesh: self.build_mesh()?,
+            field: self.field(),
+            rule: self.rule(),
+            loading: self.loading(),
+        })
+    }
+
+    /// Newton and step settings.
+    pub fn solver_settings(&self) -> Result<SolverSettings> {
+        let l = &self.loading;
+        let steps = match (l.increment, &l.compression) {
+            (Some(inc), Some(c)) => SolverSettings::steps_for_increment(c.displacement, inc)?,
+            _ => l.steps,
+        };
+        let n = &self.newton;
+        Ok(SolverSettings {
+            steps,
+            max_iterations: n.max_iterations,
+            force_tolerance: n.force_tolerance,
+            displacement_tolerance: n.displacement_tolerance,
+            line_search: n.line_search,
+            min_increment_fraction: n.min_increment_fraction,
+            tolerated_residual: n.tolerated_residual,
+            secant_updates: n.secant_updates,
+            stall_iterations: n.stall_iterations,
+            forced_residual: n.forced_residual,
+            ..SolverSettings::default()
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::{Continuum, ElementChoice, Integration, Job, fixtures};
+    use cosdem_fem::assembly::Component;
+
+    fn minimal() -> Job {
+        fixtures::load("elastic-panel")
+    }
+
+    #[test]
+    fn minimal_job_takes_the_documented_defaults() {
+        let job = minimal();
+        assert_eq!(job.mesh.element, ElementChoice::Q8);
+        assert_eq!(job.mesh.integration, Integration::Reduced);
+        assert_eq!(job.mesh.continuum, Continuum::Cosserat);
+        assert_eq!(job.output.vtk_every, 1);
+        assert_eq!(job.loading.load_set, "top");
+        let model = job.model().unwrap();
+        assert_eq!(model.mesh.n_elements(), 4);
+        assert_eq!(job.solver_settings().unwrap().steps, 4);
+    }
+
+    #[test]
+    fn increment_gives_the_number_of_steps() {
+        let text = fixtures::text("elastic-panel").replace("steps = 4", "increment = 0.001");
+        let job = Job::from_toml(&text, "j").unwrap();
+        assert_eq!(job.solver_settings().unwrap().steps, 10);
+    }
+
+    #[test]
+    fn symmetric_compression_moves_both_platens_by_half() {
+        let l = minimal().loading();
+        let top = l.dirichlet.iter().find(|d| d.set == "top" && d.component == Component::Uy);
+        let bottom = l.dirichlet.iter().find(|d| d.set == "bottom" && d.component == Component::Uy);
+        assert_eq!(top.unwrap().value, -0.005);
+        assert_eq!(bottom.unwrap().value, 0.005);
+    }
+}

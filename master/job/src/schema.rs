@@ -1,0 +1,373 @@
+//! The tables of the job file as serde structs: every key, its meaning and its default.
+//! Unknown keys are refused (`deny_unknown_fields`); ranges are checked by [`Job::validate`].
+
+use cosdem_fem::solve::SolverSettings;
+use cosdem_fem::symmetry::Symmetry;
+use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
+
+/// A whole job.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Job {
+    /// Free text shown in the summary.
+    #[serde(default)]
+    pub title: String,
+    /// Accuracy target (fraction in (0, 1), e.g. 0.05 for 5 %): when given, the speed knobs
+    /// of `[material.assembly]` and the load step are chosen by `cosdem_tune::accuracy` from the
+    /// measured speed/accuracy trade before the run. Absent (the default): the job runs as
+    /// written.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub accuracy: Option<f64>,
+    /// The macro mesh.
+    pub mesh: MeshSection,
+    /// Boundary conditions, loads and load steps.
+    #[serde(default)]
+    pub loading: LoadingSection,
+    /// The material at the Gauss points.
+    pub material: MaterialSection,
+    /// Newton-Raphson and step control.
+    #[serde(default)]
+    pub newton: NewtonSection,
+    /// What is written, and how often.
+    #[serde(default)]
+    pub output: OutputSection,
+    /// Where the DEM assemblies are solved.
+    #[serde(default)]
+    pub workers: WorkersSection,
+}
+
+/// How the mesh is made.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MeshKind {
+    /// A structured rectangle `lx` x `ly` with `nx` x `ny` elements.
+    Rectangle,
+    /// A Gmsh `.msh` file (2.2 or 4.1) of 8- or 9-node quadrilaterals.
+    Gmsh,
+}
+
+/// Element family of a structured mesh.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ElementChoice {
+    /// 8-node serendipity quadrilateral (the paper's).
+    Q8,
+    /// 9-node Lagrange quadrilateral.
+    Q9,
+}
+
+/// Gauss rule.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Integration {
+    /// 2x2 points per element (the paper's; one DEM assembly per point).
+    Reduced,
+    /// 3x3 points per element.
+    Full,
+}
+
+/// The continuum.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Continuum {
+    /// `u_x, u_y, w` per node (the paper's).
+    Cosserat,
+    /// `u_x, u_y` per node (Guo & Zhao's FEMxDEM is Cauchy).
+    Cauchy,
+}
+
+/// `[mesh]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshSection {
+    /// `rectangle` or `gmsh`.
+    pub kind: MeshKind,
+    /// Width (m), rectangle only.
+    pub lx: Option<f64>,
+    /// Height (m), rectangle only.
+    pub ly: Option<f64>,
+    /// Elements along x, rectangle only.
+    pub nx: Option<usize>,
+    /// Elements along y, rectangle only.
+    pub ny: Option<usize>,
+    /// Lower-left corner (m), rectangle only; default `[0, 0]`.
+    #[serde(default)]
+    pub origin: [f64; 2],
+    /// `q8` (default) or `q9`, rectangle only (a Gmsh file says its own).
+    #[serde(default = "default_element")]
+    pub element: ElementChoice,
+    /// `reduced` (2x2, default) or `full` (3x3).
+    #[serde(default = "default_integration")]
+    pub integration: Integration,
+    /// `cosserat` (default) or `cauchy`.
+    #[serde(default = "default_continuum")]
+    pub continuum: Continuum,
+    /// The `.msh` file, gmsh only; relative to the job file.
+    pub file: Option<PathBuf>,
+    /// `none` (default), `half_x` or `quarter`: mesh only the left half or lower-left quarter
+    /// of a symmetric rectangle (see [`cosdem_fem::symmetry`]).
+    #[serde(default)]
+    pub symmetry: Symmetry,
+}
+
+fn default_element() -> ElementChoice {
+    ElementChoice::Q8
+}
+fn default_integration() -> Integration {
+    Integration::Reduced
+}
+fn default_continuum() -> Continuum {
+    Continuum::Cosserat
+}
+
+/// Which platens move in a compression.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Moving {
+    /// Top down and bottom up by half the shortening each (the paper: "applied to the top
+    /// and bottom").
+    Both,
+    /// Top down by the whole shortening, bottom held.
+    Top,
+}
+
+/// Platen friction.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PlatenChoice {
+    /// `u_x = 0` on top and bottom (default).
+    Rough,
+    /// `u_x` free on top and bottom (one node pinned).
+    Smooth,
+}
+
+/// `[loading.compression]`: the paper's platen compression.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Compression {
+    /// Total shortening at the end of the run (m, positive).
+    pub displacement: f64,
+    /// `rough` (default) or `smooth`.
+    #[serde(default = "default_platens")]
+    pub platens: PlatenChoice,
+    /// `both` (default) or `top`.
+    #[serde(default = "default_moving")]
+    pub moving: Moving,
+}
+
+fn default_platens() -> PlatenChoice {
+    PlatenChoice::Rough
+}
+fn default_moving() -> Moving {
+    Moving::Both
+}
+
+/// Dof component names in the job file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ComponentChoice {
+    /// `u_x`.
+    Ux,
+    /// `u_y`.
+    Uy,
+    /// `w` (Cosserat only).
+    W,
+}
+
+/// `[[loading.prescribed]]`: a dof value on a node set, reached at the end of the run.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Prescribed {
+    /// Node set (`top`, `bottom`, `left`, `right`, corners, or a Gmsh physical name).
+    pub set: String,
+    /// `ux`, `uy` or `w`.
+    pub component: ComponentChoice,
+    /// Final value (m or rad); grows linearly over the load steps.
+    pub value: f64,
+}
+
+/// How an edge load follows the loading.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RampChoice {
+    /// Full from the first step (a confining pressure; default).
+    Constant,
+    /// Grows with the load factor.
+    Linear,
+}
+
+/// `[[loading.pressure]]`: a pressure on an edge set.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PressureLoad {
+    /// Edge set.
+    pub set: String,
+    /// Pressure (Pa, positive pushes into the body).
+    pub value: f64,
+    /// `constant` (default) or `linear`.
+    #[serde(default = "default_ramp")]
+    pub ramp: RampChoice,
+}
+
+fn default_ramp() -> RampChoice {
+    RampChoice::Constant
+}
+
+/// `[loading]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LoadingSection {
+    /// Number of equal load steps (default 10); ignored when `increment` is given.
+    #[serde(default = "default_steps")]
+    pub steps: usize,
+    /// Displacement increment per step (m) of the compression, instead of `steps`.
+    pub increment: Option<f64>,
+    /// Platen compression (the paper's scenes).
+    pub compression: Option<Compression>,
+    /// Further prescribed dofs.
+    #[serde(default)]
+    pub prescribed: Vec<Prescribed>,
+    /// Pressures on edge sets.
+    #[serde(default)]
+    pub pressure: Vec<PressureLoad>,
+    /// Node set whose reaction is "the load" of the curve (default `top`).
+    #[serde(default = "default_load_set")]
+    pub load_set: String,
+}
+
+fn default_steps() -> usize {
+    10
+}
+fn default_load_set() -> String {
+    "top".into()
+}
+
+impl Default for LoadingSection {
+    fn default() -> Self {
+        Self {
+            steps: default_steps(),
+            increment: None,
+            compression: None,
+            prescribed: Vec::new(),
+            pressure: Vec::new(),
+            load_set: default_load_set(),
+        }
+    }
+}
+
+/// `[material]`: what answers at the Gauss points.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum MaterialSection {
+    /// Linear-elastic Cosserat (THEORY.md Eq. 8): cheap, for checks and calibration.
+    Elastic {
+        /// Shear modulus G (Pa).
+        shear_modulus: f64,
+        /// Poisson's ratio, in (-1, 0.5).
+        poisson: f64,
+        /// Cosserat shear modulus Gc (Pa); default G / 2.
+        cosserat_modulus: Option<f64>,
+        /// Internal length lc (m); default 0.01.
+        length: Option<f64>,
+    },
+    /// A DEM disc assembly at every Gauss point (the paper's two-scale model). The table
+    /// `[material.assembly]` is the worker's assembly spec: packing, contact law, density,
+    /// micro boundary, relaxation and tangent (see `docs/reference/job-file.md`).
+    Dem {
+        /// The assembly spec, identical at every Gauss point.
+        assembly: Box<cosdem_dem::AssemblySpec>,
+    },
+}
+
+/// `[newton]`: Newton-Raphson and step control. Defaults are [`SolverSettings::default`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct NewtonSection {
+    /// Iterations per attempt before the step is cut.
+    pub max_iterations: u32,
+    /// Relative force residual that ends the iteration.
+    pub force_tolerance: f64,
+    /// Relative displacement increment that ends the iteration.
+    pub displacement_tolerance: f64,
+    /// Backtracking line search when the residual grows.
+    pub line_search: bool,
+    /// Smallest step as a fraction of the nominal one.
+    pub min_increment_fraction: f64,
+    /// Relative force residual at which a step that ran out of iterations is accepted as
+    /// "tolerated" instead of cut (0 = never; see `SolverSettings::tolerated_residual`).
+    pub tolerated_residual: f64,
+    /// Gauss-point secant updates of the iteration matrix within a step (see
+    /// `SolverSettings::secant_updates`).
+    pub secant_updates: bool,
+    /// Iterations without a new smallest residual after which an attempt whose best is
+    /// already within `tolerated_residual` is accepted there (0 = off; see
+    /// `SolverSettings::stall_iterations`).
+    pub stall_iterations: u32,
+    /// Relative force residual up to which the attempt at the smallest increment accepts its
+    /// best iterate instead of ending the run, as a "forced" step (0 = never; see
+    /// `SolverSettings::forced_residual`).
+    pub forced_residual: f64,
+}
+
+impl Default for NewtonSection {
+    fn default() -> Self {
+        let s = SolverSettings::default();
+        Self {
+            max_iterations: s.max_iterations,
+            force_tolerance: s.force_tolerance,
+            displacement_tolerance: s.displacement_tolerance,
+            line_search: s.line_search,
+            min_increment_fraction: s.min_increment_fraction,
+            tolerated_residual: s.tolerated_residual,
+            secant_updates: s.secant_updates,
+            stall_iterations: s.stall_iterations,
+            forced_residual: s.forced_residual,
+        }
+    }
+}
+
+/// `[output]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct OutputSection {
+    /// Run directory; the CLI's `--out` wins; default `runs/<job file stem>`.
+    pub dir: Option<PathBuf>,
+    /// Write the VTK fields every this many steps (0: never).
+    pub vtk_every: usize,
+    /// Gauss points `[element, point]` whose particle snapshots are written.
+    pub snapshots: Vec<[u32; 2]>,
+    /// Displacements (m) at which the equivalent-strain field is plotted.
+    pub field_plots_at: Vec<f64>,
+    /// Write `checkpoint.bin` every this many steps (0: only when stopped by Ctrl-C).
+    pub checkpoint_every: usize,
+    /// Upper end (m) of the linear range the stiffness E is fitted over
+    /// ([`cosdem_fem::post::CurveMetrics`]); the paper's 0.01 m.
+    pub linear_range: f64,
+}
+
+/// The paper's linear range for the stiffness E: displacements up to 0.01 m.
+pub const PAPER_LINEAR_RANGE: f64 = 0.01;
+
+impl Default for OutputSection {
+    fn default() -> Self {
+        Self {
+            dir: None,
+            vtk_every: 1,
+            snapshots: Vec::new(),
+            field_plots_at: Vec::new(),
+            checkpoint_every: 1,
+            linear_range: PAPER_LINEAR_RANGE,
+        }
+    }
+}
+
+/// `[workers]`.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct WorkersSection {
+    /// Remote workers `host:port` or `dns:NAME:PORT`; empty: in-process workers.
+    pub addresses: Vec<String>,
+    /// Number of in-process workers (0: one per core).
+    pub in_process: usize,
+}
