@@ -1,6 +1,8 @@
 //! The cosdem application: a job run to its end into a run directory.
 //!
-//! [`run`] is the run driver (the material for a job, the solver, the writer); [`checkpoint`]
+//! [`run`] is the one run driver ([`run::Run`]: the material for a job, the solver, the
+//! writer, one per-step hook for the run directory, checkpoints and the caller's observer),
+//! through which the CLI, the sweeps, the studies and the tests run jobs; [`checkpoint`]
 //! saves and restores a run; [`output`] writes the run directory (curve, VTK, summary,
 //! snapshots) and draws its figures; [`rve`] drives one assembly through a laboratory path
 //! (`cosdem rve`, calibration).
@@ -9,7 +11,7 @@
 pub mod checkpoint;
 /// Writing results: VTK unstructured grids, ParaView collections, CSV curves, plots.
 pub mod output;
-/// One job run to its end into a run directory (the library side of `cosdem run`).
+/// One job run to its end into a run directory: the one run driver ([`run::Run`]).
 pub mod run;
 /// One DEM assembly driven through a laboratory path (biaxial, isotropic, simple shear):
 /// `cosdem rve`, for calibrating micro parameters.

@@ -1,12 +1,21 @@
 //! One job, run to its end into a run directory: the library side of `cosdem run`.
 //!
-//! [`material_for`] turns the job's `[material]` into what answers at the Gauss points (an
-//! analytical material, or a pool of DEM workers holding one assembly per Gauss point);
-//! [`execute`] runs the solver into a [`RunWriter`] and returns the summary. The CLI adds the
-//! progress bar, logging and signal handling on top; batch drivers (the speed/accuracy sweep,
-//! the RVE-size study) call [`run_job`] directly.
+//! [`Run`] is the one run driver: `cosdem run`, the speed/accuracy sweep, the RVE-size study
+//! and the tests all run a job through it. [`material_for`] turns the job's `[material]` into
+//! what answers at the Gauss points (an analytical material, or a pool of DEM workers holding
+//! one assembly per Gauss point); [`observer`] is the per-step hook the run directory, the
+//! checkpoints and the caller's [`RunObserver`] hang on. The CLI adds the progress bar, logging
+//! and the printed summary; [`run_job`] is the plain run the sweep makes.
 
-use crate::output::run_dir::{RunSettings, RunWriter, Summary};
+/// The [`Run`] builder: options, order of a run, outcome.
+pub mod driver;
+/// What a caller sees of a run ([`RunObserver`]) and the per-step hook.
+pub mod observer;
+
+pub use driver::{BuildMaterial, Ending, Run, RunOutcome};
+pub use observer::{HookError, RunObserver};
+
+use crate::output::run_dir::{RunSettings, Summary};
 use cosdem_common::GaussPointId;
 use cosdem_common::micro::{AssemblyRequest, AssemblyState, BoundaryKind};
 use cosdem_fem::material::Material;
@@ -34,6 +43,24 @@ pub enum RunError {
     /// The accuracy target could not be turned into settings.
     #[error(transparent)]
     Accuracy(#[from] cosdem_tune::accuracy::AccuracyError),
+    /// The run directory could not be created.
+    #[error("creating {}", path.display())]
+    CreateDir {
+        /// The directory.
+        path: std::path::PathBuf,
+        /// Why.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The Ctrl-C / SIGTERM handler could not be installed.
+    #[error("installing the Ctrl-C handler")]
+    Signals(#[source] std::io::Error),
+    /// A resume, checkpoints or a stop were asked of a run without a directory.
+    #[error("a resume, checkpoints or a stop need a run directory")]
+    NoRunDirectory,
+    /// The caller's [`RunObserver`] failed.
+    #[error(transparent)]
+    Observer(HookError),
 }
 
 /// The job to run: `job` itself (unchanged, bit for bit) when it has no `accuracy` key, else
@@ -136,32 +163,19 @@ pub fn material_for(
     }
 }
 
-/// Runs `job` into `dir` (created) and returns the final summary and curve. A run that stops
-/// early (a step that cannot be cut further, a failed worker) still returns its summary, with
-/// `status = "failed: ..."` and the steps it finished: the curve so far is what the caller
-/// judges. Only errors before the first step (the job, the pool, the output directory) are
-/// returned as `Err`. A job with `accuracy` runs with the settings [`tuned`] picks, and its
-/// report is written to `dir/accuracy.json` and logged.
+/// Runs `job` into `dir` (created) and returns the final summary and curve: a plain
+/// [`Run`] (no checkpoints, no particle snapshots). A run that stops early (a step that cannot
+/// be cut further, a failed worker) still returns its summary, with `status = "failed: ..."`
+/// and the steps it finished: the curve so far is what the caller judges. Only errors before
+/// the first step (the job, the pool, the output directory) are returned as `Err`. A job with
+/// `accuracy` runs with the settings [`tuned`] picks, and its report is written to
+/// `dir/accuracy.json` and logged.
 pub fn run_job(
     job: &Job,
     dir: &Path,
     workers: &WorkerChoice,
 ) -> Result<(Summary, Vec<(f64, f64)>), RunError> {
-    let (job, report) = tuned(job)?;
-    let job = &job;
-    let mut writer = RunWriter::create(dir, run_settings(job))?;
-    if let Some(report) = &report {
-        write_accuracy_report(report, dir)?;
-        for line in report.lines() {
-            tracing::info!("{line}");
-        }
-    }
-    let mut solver = Solver::new(job.model()?, job.solver_settings()?)?;
-    let ids = gauss_point_ids(&solver);
-    let (mut material, n) = material_for(job, workers, &ids, None)?;
-    writer.set_workers(n);
-    let outcome = solver.run(material.as_mut(), &mut writer);
-    writer.add_uncommitted_dem_steps(solver.uncommitted_dem_steps());
-    writer.finish(outcome.as_ref().map(|_| ()).map_err(|e| e.to_string()))?;
-    Ok((writer.summary().clone(), writer.curve().to_vec()))
+    let outcome = Run::new(job, dir).workers(workers.clone()).execute()?;
+    let summary = outcome.summary.expect("a run with a directory has a summary");
+    Ok((summary, outcome.curve))
 }

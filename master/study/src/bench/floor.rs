@@ -64,7 +64,7 @@ fn fit_line(x: &[f64], y: &[f64]) -> (f64, f64) {
 
 /// Figure 0: the coupling's own cost, without DEM work. One worker x one thread holds
 /// `points` stand-in assemblies whose solve does no work (microseconds); per iteration one
-/// evaluate (one SolveBatch) and one commit, as in [`overhead`]. The time per iteration
+/// evaluate (one SolveBatch) and one commit, as in [`super::overhead`]. The time per iteration
 /// against the batch size, fitted by `a + b n`, splits it into the fixed cost per iteration
 /// (`a`: the SolveBatch and Commit round trips, thread hand-offs) and the cost per Gauss
 /// point (`b`: (de)serialization, one streamed message, one relaxation task). In-process

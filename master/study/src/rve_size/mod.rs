@@ -4,9 +4,10 @@
 //! The RVE-size study runs the job (scene A) once per assembly size `V`, with the packing's
 //! `side = sqrt(V)` (and optionally another disc radius), reads F_u, F_res, E and E50 off
 //! each load-displacement curve ([`CurveMetrics`]) and fits the size law of Eqs. 30-32 to
-//! each property ([`fit`]). Each run is single-threaded ([`DirectDem`]: the assemblies are
-//! solved one after the other on the run's thread), and the runs go side by side on a rayon
-//! pool: every figure but the wall time is independent of the thread count.
+//! each property ([`fit`]). Each run goes through the run driver ([`Run`], without a run
+//! directory) and is single-threaded ([`DirectDem`]: the assemblies are solved one after the
+//! other on the run's thread), and the runs go side by side on a rayon pool: every figure but
+//! the wall time is independent of the thread count.
 //!
 //! Output (`DIR`): `study.csv` (one row per size), `study.json` (the rows and the fits, for
 //! plots of Figs. 4-5), `curves/curve_<V>.csv` (each size's load-displacement curve, Fig. 3).
@@ -14,16 +15,19 @@
 /// Nonlinear least-squares fit of the size law, with confidence intervals.
 pub mod fit;
 
+use cosdem_app::output::run_dir::RunWriter;
 use cosdem_app::output::{CsvWriter, fmt_f64, write_atomic};
+use cosdem_app::run::{HookError, Run, RunError, RunObserver};
 use cosdem_dem::PackingSpec;
 use cosdem_fem::error::{Error, Result};
 use cosdem_fem::post::CurveMetrics;
-use cosdem_fem::solve::{SolutionView, Solver, StepObserver, StepReport};
+use cosdem_fem::solve::{SolutionView, StepReport};
 use cosdem_job::{Job, MaterialSection};
 use cosdem_pool::DirectDem;
 use fit::{SizeLawFit, fit_size_law};
 use rayon::prelude::*;
 use serde::Serialize;
+use std::cell::Cell;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -143,8 +147,9 @@ pub fn job_for_size(job: &Job, size: f64, radius: Option<f64>) -> Result<Job> {
     Ok(job)
 }
 
-/// Collects the curve of one run and writes it.
-struct Curve {
+/// Collects the curve of one run and writes it (`curves/curve_<V>.csv`, opened when the
+/// first step is about to be solved).
+struct Curve<'p> {
     shortening: f64,
     /// Reaction multiplier of a symmetric mesh (2 for a half or quarter: the reaction of the
     /// kept part of `load_set` is half the platen force).
@@ -152,11 +157,26 @@ struct Curve {
     load_set: String,
     points: Vec<(f64, f64)>,
     dem_steps: u64,
+    path: Option<&'p Path>,
     csv: Option<CsvWriter>,
 }
 
-impl StepObserver for Curve {
-    fn on_step(&mut self, r: &StepReport, view: &SolutionView<'_>) -> Result<()> {
+impl RunObserver for Curve<'_> {
+    fn on_start(&mut self) -> std::result::Result<(), HookError> {
+        if let Some(p) = self.path {
+            let csv = CsvWriter::create(p, &["step", "displacement", "load", "dem_steps"])
+                .map_err(|e| Error::Observer(e.to_string()))?;
+            self.csv = Some(csv);
+        }
+        Ok(())
+    }
+
+    fn on_step(
+        &mut self,
+        r: &StepReport,
+        view: &SolutionView<'_>,
+        _: Option<&RunWriter>,
+    ) -> Result<()> {
         let d = r.load_factor * self.shortening;
         let load = -self.load_scale * r.reactions.get(&self.load_set).map_or(0.0, |x| x[1]);
         let dem: u64 = view.gauss_points.iter().map(|g| g.diagnostics.steps).sum();
@@ -167,6 +187,18 @@ impl StepObserver for Curve {
                 .map_err(|e| Error::Observer(e.to_string()))?;
         }
         Ok(())
+    }
+}
+
+/// The solver's error behind a run driver's error (the error of a hook of [`Curve`] included).
+fn solver_error(e: RunError) -> Error {
+    match e {
+        RunError::Solver(e) => e,
+        RunError::Observer(e) => match e.downcast::<Error>() {
+            Ok(e) => *e,
+            Err(e) => Error::Observer(e.to_string()),
+        },
+        other => Error::Observer(other.to_string()),
     }
 }
 
@@ -186,43 +218,42 @@ pub fn run_size(
     curve: Option<&Path>,
 ) -> Result<SizeRun> {
     let t0 = Instant::now();
-    let job = job_for_size(job, size, settings.radius)?;
+    let mut job = job_for_size(job, size, settings.radius)?;
+    // The study sets the assembly size itself: an accuracy target, which would pick one, is
+    // not planned.
+    job.accuracy = None;
     let MaterialSection::Dem { assembly } = &job.material else { unreachable!("checked") };
     let radius = largest_radius(&assembly.packing);
-    let mut solver = Solver::new(job.model()?, job.solver_settings()?)?;
-    let ids = cosdem_app::run::gauss_point_ids(&solver);
-    let mut material = DirectDem::new(assembly, &ids)?;
-    let csv = match curve {
-        Some(p) => Some(
-            CsvWriter::create(p, &["step", "displacement", "load", "dem_steps"])
-                .map_err(|e| Error::Observer(e.to_string()))?,
-        ),
-        None => None,
-    };
     let mut obs = Curve {
         shortening: job.shortening(),
         load_scale: job.load_scale(),
         load_set: job.loading.load_set.clone(),
         points: Vec::new(),
         dem_steps: 0,
-        csv,
+        path: curve,
+        csv: None,
     };
-    let outcome = solver.run(&mut material, &mut obs);
-    let status = match &outcome {
-        Ok(_) => "finished".to_string(),
-        Err(e) => format!("failed: {e}"),
-    };
+    let discs = Cell::new(0);
+    let outcome = Run::without_dir(&job)
+        .material(|ids| {
+            let m = DirectDem::new(assembly, ids).map_err(Error::from)?;
+            discs.set(m.disc_count());
+            Ok(Box::new(m))
+        })
+        .observer(&mut obs)
+        .execute()
+        .map_err(solver_error)?;
     Ok(SizeRun {
         size,
         side: size.sqrt(),
         radius,
-        discs: material.disc_count(),
+        discs: discs.get(),
         steps: obs.points.len() as u64,
         metrics: CurveMetrics::from_curve(&obs.points, job.output.linear_range),
         // The failed attempts of a step that ended the run cost DEM steps too.
-        dem_steps: obs.dem_steps + solver.uncommitted_dem_steps(),
+        dem_steps: obs.dem_steps + outcome.uncommitted_dem_steps,
         wall_seconds: t0.elapsed().as_secs_f64(),
-        status,
+        status: outcome.ending.status(),
     })
 }
 

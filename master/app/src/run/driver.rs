@@ -1,0 +1,321 @@
+//! [`Run`]: the one way a job is run, whoever runs it (`cosdem run`, the speed/accuracy sweep,
+//! the RVE-size study, the tests).
+//!
+//! The order of a run: the accuracy target is planned ([`super::tuned`]); the run directory is
+//! created (and the caller told, [`RunObserver::on_dir`]) and the plan written into it; a
+//! resume reads and checks the checkpoint; the run writer is created (or continued); the
+//! solver and the material are built (the job's pool, or the caller's material) and the
+//! checkpoint's states restored; then the solver runs with one per-step hook
+//! ([`super::observer`]) and the summary gets its status.
+
+use super::observer::{RunObserver, Silent, StepHook};
+use super::{RunError, WorkerChoice, gauss_point_ids, material_for, run_settings, tuned};
+use crate::checkpoint::{self, Checkpoint, Checkpointer};
+use crate::output::run_dir::{RunWriter, Summary};
+use crate::output::snapshots::resolve_snapshot_ids;
+use cosdem_common::GaussPointId;
+use cosdem_fem::material::Material;
+use cosdem_fem::solve::Solver;
+use cosdem_job::Job;
+use std::path::Path;
+use std::sync::Arc;
+use std::sync::atomic::AtomicBool;
+
+/// Builds the material of a run from the Gauss points of its mesh (element-major).
+pub type BuildMaterial<'a> =
+    Box<dyn FnOnce(&[GaussPointId]) -> Result<Box<dyn Material>, RunError> + 'a>;
+
+/// What may stop a run cleanly after a step (checkpoint written, status `interrupted`).
+enum Stop {
+    Never,
+    Flag(Arc<AtomicBool>),
+    Signals,
+}
+
+/// How a run ended.
+#[derive(Debug)]
+pub enum Ending {
+    /// Every load step converged.
+    Finished,
+    /// A step could not be solved (cut as far as allowed, a worker lost, ...); the finished
+    /// steps are written.
+    Failed(cosdem_fem::Error),
+    /// Stopped on request ([`Run::stop_flag`], Ctrl-C, SIGTERM) with its checkpoint written.
+    Interrupted,
+    /// Stopped at [`Run::max_steps`] with its checkpoint written.
+    Stopped,
+}
+
+impl Ending {
+    /// The summary's `status`: `finished`, `failed: <reason>`, `interrupted` or `stopped`.
+    pub fn status(&self) -> String {
+        match self {
+            Self::Finished => "finished".into(),
+            Self::Failed(e) => format!("failed: {e}"),
+            Self::Interrupted => "interrupted".into(),
+            Self::Stopped => "stopped".into(),
+        }
+    }
+}
+
+/// What [`Run::execute`] returns.
+#[derive(Debug)]
+pub struct RunOutcome {
+    /// How the run ended.
+    pub ending: Ending,
+    /// The final summary (also `summary.json`); `None` for a run without a directory.
+    pub summary: Option<Summary>,
+    /// `(displacement, load)` per committed step, resumed steps included; empty for a run
+    /// without a directory.
+    pub curve: Vec<(f64, f64)>,
+    /// The last committed step.
+    pub steps: u64,
+    /// DEM steps of the failed attempts of the step that ended the run (already in the
+    /// summary's `dem_steps`).
+    pub uncommitted_dem_steps: u64,
+}
+
+/// One job run to its end: a builder. `Run::new(&job, dir).execute()` is a plain run into
+/// `dir` with the job's material (in-process workers for a DEM job), no checkpoints, no
+/// particle snapshots; each option adds what `cosdem run` does.
+pub struct Run<'a> {
+    job: &'a Job,
+    dir: Option<&'a Path>,
+    workers: WorkerChoice,
+    material: Option<BuildMaterial<'a>>,
+    resume: Option<bool>,
+    checkpoints: bool,
+    snapshots: bool,
+    max_steps: Option<u64>,
+    stop: Stop,
+    observer: Option<&'a mut dyn RunObserver>,
+}
+
+impl<'a> Run<'a> {
+    /// A run of `job` into the run directory `dir` (created if needed).
+    pub fn new(job: &'a Job, dir: &'a Path) -> Self {
+        Self { dir: Some(dir), ..Self::without_dir(job) }
+    }
+
+    /// A run of `job` that writes nothing: the caller's observer ([`Run::observer`]) sees the
+    /// steps (the RVE-size study). No resume, checkpoints or stop.
+    pub fn without_dir(job: &'a Job) -> Self {
+        Self {
+            job,
+            dir: None,
+            workers: WorkerChoice::default(),
+            material: None,
+            resume: None,
+            checkpoints: false,
+            snapshots: false,
+            max_steps: None,
+            stop: Stop::Never,
+            observer: None,
+        }
+    }
+
+    /// Where the job's DEM assemblies are solved (default: the job's in-process workers).
+    pub fn workers(mut self, workers: WorkerChoice) -> Self {
+        self.workers = workers;
+        self
+    }
+
+    /// Runs with the material `build` makes for the mesh's Gauss points instead of the job's
+    /// (e.g. [`cosdem_pool::DirectDem`], every assembly on the run's thread). The summary
+    /// counts 0 workers. On a resume the checkpoint's states are restored into it.
+    pub fn material(
+        mut self,
+        build: impl FnOnce(&[GaussPointId]) -> Result<Box<dyn Material>, RunError> + 'a,
+    ) -> Self {
+        self.material = Some(Box::new(build));
+        self
+    }
+
+    /// Goes on from the run directory's checkpoint instead of starting again (checkpoints
+    /// on). `newton_changed`: the job's `[newton]` settings may differ from the checkpoint's
+    /// (see [`Checkpoint::check_job`]).
+    pub fn resume(mut self, newton_changed: bool) -> Self {
+        self.resume = Some(newton_changed);
+        self.checkpoints = true;
+        self
+    }
+
+    /// Writes `checkpoint.bin` every `[output] checkpoint_every` steps and when stopped.
+    pub fn checkpoints(mut self, on: bool) -> Self {
+        self.checkpoints = on;
+        self
+    }
+
+    /// Writes the particle snapshots of the job's `[output] snapshots` and the field data of
+    /// its `field_plots_at` (the field data of the last step is always written).
+    pub fn snapshots(mut self, on: bool) -> Self {
+        self.snapshots = on;
+        self
+    }
+
+    /// Stops cleanly once `max_steps` steps are committed (resumed steps included): status
+    /// `stopped`, checkpoint written (checkpoints on), [`Run::resume`] goes on.
+    pub fn max_steps(mut self, max_steps: Option<u64>) -> Self {
+        self.max_steps = max_steps;
+        if max_steps.is_some() {
+            self.checkpoints = true;
+        }
+        self
+    }
+
+    /// Stops cleanly after the step during which `flag` is set: status `interrupted`,
+    /// checkpoint written (checkpoints on).
+    pub fn stop_flag(mut self, flag: Arc<AtomicBool>) -> Self {
+        self.stop = Stop::Flag(flag);
+        self.checkpoints = true;
+        self
+    }
+
+    /// Stops cleanly on the first Ctrl-C or SIGTERM, as [`Run::stop_flag`]
+    /// ([`checkpoint::ctrl_c_flag`], installed just before the first step).
+    pub fn stop_on_signals(mut self) -> Self {
+        self.stop = Stop::Signals;
+        self.checkpoints = true;
+        self
+    }
+
+    /// Tells `observer` about the run as it goes.
+    pub fn observer(mut self, observer: &'a mut dyn RunObserver) -> Self {
+        self.observer = Some(observer);
+        self
+    }
+
+    /// Runs the job. A run that ends early (a step that cannot be cut further, a lost worker,
+    /// a stop) still returns its outcome, the finished steps written: only errors before the
+    /// first step (the job, the checkpoint, the material, the run directory) and failures to
+    /// write the summary are `Err`.
+    pub fn execute(self) -> Result<RunOutcome, RunError> {
+        let Run { dir, workers, material, resume, checkpoints, snapshots, max_steps, stop, .. } =
+            self;
+        let mut silent = Silent;
+        let observer: &mut dyn RunObserver = match self.observer {
+            Some(o) => o,
+            None => &mut silent,
+        };
+        if dir.is_none() && checkpoints {
+            return Err(RunError::NoRunDirectory);
+        }
+        // `accuracy`: the settings picked for the target replace the job's (a pure function
+        // of the job, so a resume picks the same ones).
+        let (job, report) = tuned(self.job)?;
+        let job = &job;
+        if let Some(dir) = dir {
+            std::fs::create_dir_all(dir)
+                .map_err(|source| RunError::CreateDir { path: dir.to_path_buf(), source })?;
+            observer.on_dir(dir).map_err(RunError::Observer)?;
+        }
+        if let Some(report) = &report {
+            if let Some(dir) = dir {
+                super::write_accuracy_report(report, dir)?;
+            }
+            for line in report.lines() {
+                observer.on_plan_line(&line);
+                tracing::info!("{line}");
+            }
+        }
+        let checkpoint = match (resume, dir) {
+            (Some(newton_changed), Some(dir)) => {
+                let path = dir.join(checkpoint::FILE);
+                let c = Checkpoint::read(&path)?;
+                c.check_job(job, &path, newton_changed)?;
+                tracing::info!(step = c.solver.step, "resuming from {}", path.display());
+                Some(c)
+            }
+            _ => None,
+        };
+        let mut writer = match (dir, &checkpoint) {
+            (Some(dir), Some(c)) => Some(RunWriter::resume(dir, run_settings(job), c.solver.step)?),
+            (Some(dir), None) => Some(RunWriter::create(dir, run_settings(job))?),
+            (None, _) => None,
+        };
+        let mut solver = Solver::new(job.model()?, job.solver_settings()?)?;
+        let ids = gauss_point_ids(&solver);
+        let watched = if snapshots {
+            resolve_snapshot_ids(
+                &job.output.snapshots,
+                solver.model().mesh.n_elements(),
+                solver.gauss().per_element,
+            )?
+        } else {
+            Vec::new()
+        };
+        let saved = checkpoint.as_ref().map(Checkpoint::assembly_states);
+        let (mut material, n_workers) = match material {
+            None => material_for(job, &workers, &ids, saved)?,
+            Some(build) => {
+                let mut m = build(&ids)?;
+                if let Some(states) = saved {
+                    m.restore_states(states).map_err(cosdem_fem::Error::from)?;
+                }
+                (m, 0)
+            }
+        };
+        if let Some(c) = checkpoint {
+            solver.restore(c.solver)?;
+        }
+        let stop = match stop {
+            Stop::Never => Arc::new(AtomicBool::new(false)),
+            Stop::Flag(flag) => flag,
+            Stop::Signals => checkpoint::ctrl_c_flag().map_err(RunError::Signals)?,
+        };
+        let mut tap;
+        let material: &mut dyn Material = match writer.as_mut() {
+            Some(w) if snapshots => {
+                tap = w.watch(material.as_mut(), watched, &job.output.field_plots_at);
+                &mut tap
+            }
+            _ => material.as_mut(),
+        };
+        if let Some(w) = writer.as_mut() {
+            w.set_workers(n_workers);
+        }
+        observer.on_start().map_err(RunError::Observer)?;
+        let (outcome, reached_max) = {
+            let hook = StepHook { writer: writer.as_mut(), observer: &mut *observer };
+            match dir {
+                Some(dir) if checkpoints => {
+                    let every = job.output.checkpoint_every;
+                    let mut hook =
+                        Checkpointer::new(hook, dir, every, job, stop).stop_at(max_steps);
+                    let outcome = solver.run(material, &mut hook);
+                    (outcome, hook.reached(solver.step()))
+                }
+                _ => {
+                    let mut hook = hook;
+                    (solver.run(material, &mut hook), false)
+                }
+            }
+        };
+        observer.on_end();
+        let uncommitted_dem_steps = solver.uncommitted_dem_steps();
+        let ending = match outcome {
+            Ok(_) => Ending::Finished,
+            Err(cosdem_fem::Error::Interrupted { .. }) if checkpoints && reached_max => {
+                Ending::Stopped
+            }
+            Err(cosdem_fem::Error::Interrupted { .. }) if checkpoints => Ending::Interrupted,
+            Err(e) => Ending::Failed(e),
+        };
+        if let Some(w) = writer.as_mut() {
+            w.add_uncommitted_dem_steps(uncommitted_dem_steps);
+            match &ending {
+                Ending::Finished => w.finish(Ok(()))?,
+                Ending::Failed(e) => w.finish(Err(e.to_string()))?,
+                Ending::Interrupted => w.finish_interrupted()?,
+                Ending::Stopped => w.finish_stopped()?,
+            }
+        }
+        Ok(RunOutcome {
+            ending,
+            summary: writer.as_ref().map(|w| w.summary().clone()),
+            curve: writer.as_ref().map_or_else(Vec::new, |w| w.curve().to_vec()),
+            steps: solver.step(),
+            uncommitted_dem_steps,
+        })
+    }
+}

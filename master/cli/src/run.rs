@@ -1,0 +1,206 @@
+//! `cosdem run`: a job file run through the run driver ([`cosdem_app::run::Run`]) with a
+//! progress bar, the log in `RUN/cosdem.log`, checkpoints, Ctrl-C/SIGTERM handling,
+//! `--resume` and `--max-steps`; prints the summary and draws the figures.
+
+use crate::logging::init_logging;
+use crate::plot::plot;
+use anyhow::{Context, Result};
+use cosdem_app::output::run_dir::RunWriter;
+use cosdem_app::run::{Ending, HookError, Run, RunObserver, WorkerChoice};
+use cosdem_fem::solve::{SolutionView, StepReport};
+use cosdem_job::Job;
+use cosdem_pool::PoolConfig;
+use cosdem_worker::Token;
+use indicatif::{ProgressBar, ProgressStyle};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+#[derive(clap::Args)]
+pub(crate) struct RunArgs {
+    /// The job file (TOML).
+    job: PathBuf,
+    /// Remote workers: `host:port,host:port` or `dns:NAME:PORT`; default: in-process.
+    #[arg(long, value_delimiter = ',')]
+    workers: Vec<String>,
+    /// Run directory (default: the job's `[output] dir`, else `runs/<job stem>`).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// File holding the shared token for remote workers (else env COSDEM_TOKEN).
+    #[arg(long)]
+    token_file: Option<PathBuf>,
+    /// No progress bar (logs only).
+    #[arg(long)]
+    quiet: bool,
+    /// Continue from the run directory's checkpoint.bin.
+    #[arg(long)]
+    resume: bool,
+    /// With --resume: the job's [newton] settings may differ from the checkpoint's (the steps
+    /// to come are solved with the job's; e.g. more iterations for a run that stalled).
+    #[arg(long, requires = "resume")]
+    newton_changed: bool,
+    /// Stop cleanly after this many committed steps (counted from the start of the run,
+    /// resumed steps included): checkpoint written, status `stopped`, exit code 0; go on later
+    /// with `--resume`.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    max_steps: Option<u64>,
+}
+
+/// Opens the log in the run directory, prints the accuracy plan, moves the progress bar and
+/// logs every step.
+struct Progress {
+    /// `cosdem run --resume`: the log is appended to.
+    resume: bool,
+    quiet: bool,
+    /// The job file, named by the log's `run` span.
+    job: PathBuf,
+    bar: ProgressBar,
+    started: Instant,
+    /// The `run` span, entered from the first step to the end of the command.
+    span: Option<tracing::span::EnteredSpan>,
+}
+
+impl RunObserver for Progress {
+    fn on_dir(&mut self, dir: &Path) -> Result<(), HookError> {
+        Ok(init_logging(dir, self.resume)?)
+    }
+
+    fn on_plan_line(&mut self, line: &str) {
+        eprintln!("{line}");
+    }
+
+    fn on_start(&mut self) -> Result<(), HookError> {
+        let bar = if self.quiet { ProgressBar::hidden() } else { ProgressBar::new(1000) };
+        bar.set_style(
+            ProgressStyle::with_template(
+                "[{elapsed_precise}] {bar:30} {percent:>3}% ETA {eta} {msg}",
+            )
+            .expect("static template"),
+        );
+        self.bar = bar;
+        self.span = Some(tracing::info_span!("run", job = %self.job.display()).entered());
+        self.started = Instant::now();
+        Ok(())
+    }
+
+    fn on_step(
+        &mut self,
+        r: &StepReport,
+        _: &SolutionView<'_>,
+        record: Option<&RunWriter>,
+    ) -> cosdem_fem::Result<()> {
+        let Some(writer) = record else { return Ok(()) };
+        let sum = writer.summary();
+        let secs = self.started.elapsed().as_secs_f64().max(1e-9);
+        let discs_per_s = sum.dem_steps as f64 / secs;
+        self.bar.set_position((r.load_factor * 1000.0).round() as u64);
+        self.bar.set_message(format!(
+            "step {} d={:.4e} m load={:.4e} N it={} DEM {:.2e} relax-steps/s",
+            r.step,
+            sum.displacement,
+            writer.curve().last().map_or(0.0, |p| p.1),
+            r.iterations,
+            discs_per_s
+        ));
+        tracing::info!(
+            step = r.step,
+            load_factor = r.load_factor,
+            displacement = sum.displacement,
+            iterations = r.iterations,
+            cuts = r.cuts,
+            "converged"
+        );
+        Ok(())
+    }
+
+    fn on_end(&mut self) {
+        self.bar.finish_and_clear();
+    }
+}
+
+pub(crate) fn run_dir(args: &RunArgs, job: &Job) -> PathBuf {
+    if let Some(d) = &args.out {
+        return d.clone();
+    }
+    if let Some(d) = &job.output.dir {
+        return d.clone();
+    }
+    let stem = args.job.file_stem().map_or("run".into(), |s| s.to_string_lossy().into_owned());
+    Path::new("runs").join(stem)
+}
+
+/// Where the DEM assemblies are solved: the CLI's `--workers` first, then the job's.
+fn worker_choice(job: &Job, args: &RunArgs) -> Result<WorkerChoice> {
+    let token = Token::load(args.token_file.as_deref())?;
+    let addresses =
+        if args.workers.is_empty() { job.workers.addresses.clone() } else { args.workers.clone() };
+    Ok(WorkerChoice { addresses, config: PoolConfig { token, ..PoolConfig::default() } })
+}
+
+pub(crate) fn run(args: RunArgs) -> Result<()> {
+    let job = Job::load(&args.job)?;
+    let dir = run_dir(&args, &job);
+    let workers = worker_choice(&job, &args)?;
+    let mut progress = Progress {
+        resume: args.resume,
+        quiet: args.quiet,
+        job: args.job.clone(),
+        bar: ProgressBar::hidden(),
+        started: Instant::now(),
+        span: None,
+    };
+    let mut run = Run::new(&job, &dir)
+        .workers(workers)
+        .checkpoints(true)
+        .snapshots(true)
+        .max_steps(args.max_steps)
+        .stop_on_signals()
+        .observer(&mut progress);
+    if args.resume {
+        run = run.resume(args.newton_changed);
+    }
+    let outcome = run.execute()?;
+    let s = outcome.summary.as_ref().expect("a run with a directory has a summary");
+    let m = &s.metrics;
+    println!(
+        "{} steps, d = {:.4e} m, F_u = {:.4e} N at {:.4e} m, F_res = {}, E = {}, E50 = {}, {:.1} s -> {}",
+        s.steps,
+        s.displacement,
+        m.peak_load,
+        m.peak_displacement,
+        m.residual_load.map_or("-".into(), |v| format!("{v:.4e} N")),
+        m.stiffness.map_or("-".into(), |v| format!("{v:.4e} N/m")),
+        m.stiffness_50.map_or("-".into(), |v| format!("{v:.4e} N/m")),
+        s.wall_seconds,
+        dir.display()
+    );
+    if let Err(e) = plot(&dir) {
+        eprintln!("warning: plots: {e:#}");
+        tracing::warn!(error = %format!("{e:#}"), "plots not written");
+    }
+    if s.skipped_relaxations + s.linear_answers > 0 {
+        println!(
+            "answers without relaxation: {} skipped, {} linear (largest stress-error bound {:.3e} Pa)",
+            s.skipped_relaxations, s.linear_answers, s.max_error_bound
+        );
+    }
+    match outcome.ending {
+        Ending::Finished => Ok(()),
+        Ending::Interrupted => anyhow::bail!(
+            "interrupted after step {}: finished steps and the checkpoint are in {}; continue with `cosdem run {} --resume`",
+            s.steps,
+            dir.display(),
+            args.job.display()
+        ),
+        Ending::Stopped => {
+            println!(
+                "stopped after step {} (--max-steps); continue with `cosdem run {} --resume`",
+                s.steps,
+                args.job.display()
+            );
+            Ok(())
+        }
+        Ending::Failed(e) => {
+            Err(e).with_context(|| format!("run stopped; finished steps are in {}", dir.display()))
+        }
+    }
+}
