@@ -90,7 +90,7 @@ assemble() {
 
 build_one() {
     local kind="$1" bin="$2" name="$3" image="$4" dir log
-    [[ -f "$bin" ]] || die "binary not found: $bin (build it with: cargo build --release -p cosdem-master -p cosdem-worker)"
+    [[ -f "$bin" ]] || die "binary not found: $bin (build it with: cargo build --release -p cosdem-cli -p cosdem-worker-cli)"
     [[ -x "$bin" ]] || die "not executable: $bin"
     dir="$repo/target/deploy-images/$kind"
     assemble "$dir" "$bin" "$name"

@@ -5,7 +5,7 @@
 #   deploy/test/compose-test.sh [--bin-dir DIR] [--job FILE] [--tag TAG] [--no-build]
 #
 #   --bin-dir DIR  where cosdem and cosdem-worker are (default: target/release, built
-#                  first with `cargo build --release --locked -p cosdem-master -p cosdem-worker`
+#                  first with `cargo build --release --locked -p cosdem-cli -p cosdem-worker-cli`
 #                  unless --no-build)
 #   --job FILE     the job file (default: deploy/test/job.toml, slow enough for the faults
 #                  to land during steps)
@@ -70,7 +70,7 @@ if [[ -z "$bin_dir" ]]; then
     if [[ "$build" == 1 ]]; then
         command -v cargo >/dev/null || die "cargo not found (or pass --bin-dir / --no-build)"
         log="$(mktemp)"
-        if ! (cd "$repo" && cargo build --release --locked -p cosdem-master -p cosdem-worker) >"$log" 2>&1; then
+        if ! (cd "$repo" && cargo build --release --locked -p cosdem-cli -p cosdem-worker-cli) >"$log" 2>&1; then
             cat "$log" >&2
             rm -f "$log"
             die "cargo build --release failed"
@@ -82,7 +82,7 @@ fi
 for b in cosdem cosdem-worker; do
     [[ -x "$bin_dir/$b" ]] || die "$bin_dir/$b is missing: the release binaries do not exist yet" \
         "(they come with the master and worker CLIs; build with" \
-        "'cargo build --release -p cosdem-master -p cosdem-worker')"
+        "'cargo build --release -p cosdem-cli -p cosdem-worker-cli')"
 done
 [[ -f "$job" ]] || die "job file not found: $job"
 bin_dir="$(cd "$bin_dir" && pwd)"

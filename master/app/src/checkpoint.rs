@@ -7,16 +7,28 @@
 //! `[output] checkpoint_every` steps and when the run is stopped. A run resumed from it
 //! (`cosdem run JOB --resume`) goes on bit for bit as the uninterrupted run would have: a
 //! solve is deterministic given (committed state, target), and everything else is restored
-//! exactly (bincode stores each `f64` as its bit pattern).
+//! exactly (postcard writes each `f64` as its 8 little-endian bytes).
 //!
-//! Format: the magic `CDEMCKP2`, then one bincode (standard config) [`Checkpoint`]. The
-//! checkpoint also stores a digest of the job's physics (mesh, loading, material) and one of
-//! its Newton settings: resuming with a job whose physics changed is refused, and so is one
+//! Format `CDEMCKP4`: the 8-byte header `CDEMCKP4`, one postcard [`Checkpoint`] (serde with a
+//! specified wire format), and a CRC-32 (IEEE, little-endian) of every byte before it. A
+//! damaged file (a flipped bit anywhere) is refused by its checksum, naming the file; so is a
+//! checkpoint of the older bincode formats (`CDEMCKP1`, `CDEMCKP2`) of an earlier cosdem,
+//! by name: that run must be restarted.
+//!
+//! The checksum is a CRC-32 (`crc32fast`) rather than a 64-bit hash: it is guaranteed to catch
+//! every single-bit error and every burst of up to 32 bits (a damaged disk block, a bad copy),
+//! it is the standard polynomial any zlib recomputes, and it runs at memory speed; a damaged
+//! file that matches by chance (2^-32) is no concern for a check against damage. The version
+//! is 4, not 3: `'3'` is one bit from the older `'2'` and `'1'`, so a flipped bit in a new
+//! header could pass for an older format; `'4'` is two bits from either. The assembly states
+//! inside (`cosdem_dem::Assembly::to_bytes`) carry a checksum of their own, made the same way.
+//!
+//! The checkpoint also stores a digest of the job's physics (mesh, loading, material) and one
+//! of its Newton settings: resuming with a job whose physics changed is refused, and so is one
 //! whose Newton settings changed unless the resume says so (`--newton-changed`): the steps
-//! already done stay as they were and only the steps to come are solved with the new
-//! settings (a run that stalls past a peak can go on with more iterations or another
-//! tolerance instead of starting again), so that run is no longer the uninterrupted run of
-//! either job.
+//! already done stay as they were and only the steps to come are solved with the new settings
+//! (a run that stalls past a peak can go on with more iterations or another tolerance instead
+//! of starting again), so that run is no longer the uninterrupted run of either job.
 
 use crate::output::write_atomic;
 use cosdem_common::GaussPointId;
@@ -30,10 +42,15 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
-const MAGIC: &[u8; 8] = b"CDEMCKP2";
+/// The header of the format written (postcard and a CRC-32).
+const MAGIC: &[u8; 8] = b"CDEMCKP4";
 
-/// The header of the format before the Newton settings had a digest of their own.
-const MAGIC_1: &[u8; 8] = b"CDEMCKP1";
+/// The headers of the bincode formats of earlier cosdems: `CDEMCKP1` (before the Newton
+/// settings had a digest of their own) and `CDEMCKP2`. Refused by name.
+const OLD_MAGICS: [&[u8; 8]; 2] = [b"CDEMCKP1", b"CDEMCKP2"];
+
+/// Bytes of the trailing CRC-32.
+const CRC_LEN: usize = 4;
 
 /// The checkpoint file's name in the run directory.
 pub const FILE: &str = "checkpoint.bin";
@@ -105,30 +122,56 @@ impl Checkpoint {
     /// Writes the checkpoint atomically.
     pub fn write(&self, path: &Path) -> Result<()> {
         let mut bytes = MAGIC.to_vec();
-        let body = bincode::serde::encode_to_vec(self, bincode::config::standard())
+        let body = postcard::to_allocvec(self)
             .map_err(|e| bad(path, format!("encoding the checkpoint: {e}")))?;
         bytes.extend_from_slice(&body);
+        let crc = crc32fast::hash(&bytes);
+        bytes.extend_from_slice(&crc.to_le_bytes());
         write_atomic(path, &bytes).map_err(|e| Error::Observer(e.to_string()))
     }
 
-    /// Reads a checkpoint written by [`Checkpoint::write`].
+    /// Reads a checkpoint written by [`Checkpoint::write`]. Refuses, naming the file, one of
+    /// an older format (by name), one that is not a checkpoint, and one whose checksum does
+    /// not match (damaged).
     pub fn read(path: &Path) -> Result<Self> {
         let bytes = std::fs::read(path).map_err(|e| bad(path, e.to_string()))?;
-        if bytes.starts_with(MAGIC_1) {
+        let head = &bytes[..MAGIC.len().min(bytes.len())];
+        if let Some(old) = OLD_MAGICS.iter().find(|o| head == o.as_slice()) {
             return Err(bad(
                 path,
-                "a checkpoint of the first format (CDEMCKP1, a cosdem without --newton-changed): \
-                 resume it with the cosdem that wrote it"
-                    .into(),
+                format!(
+                    "the checkpoint is in {}, the older bincode format of an earlier cosdem, \
+                     which this cosdem no longer reads: the run must be restarted (or resumed \
+                     with the cosdem that wrote it)",
+                    String::from_utf8_lossy(&old[..])
+                ),
             ));
         }
-        if !bytes.starts_with(MAGIC) {
-            return Err(bad(path, "not a cosdem checkpoint (no CDEMCKP2 header)".into()));
+        if head != MAGIC {
+            return Err(bad(
+                path,
+                "not a cosdem checkpoint (no CDEMCKP4 header), or its header is damaged".into(),
+            ));
         }
-        let (c, used): (Self, usize) =
-            bincode::serde::decode_from_slice(&bytes[MAGIC.len()..], bincode::config::standard())
-                .map_err(|e| bad(path, format!("cannot decode the checkpoint: {e}")))?;
-        if MAGIC.len() + used != bytes.len() {
+        if bytes.len() < MAGIC.len() + CRC_LEN {
+            return Err(bad(path, format!("the checkpoint is truncated ({} bytes)", bytes.len())));
+        }
+        let (covered, crc) = bytes.split_at(bytes.len() - CRC_LEN);
+        let stored = u32::from_le_bytes(crc.try_into().expect("4 bytes"));
+        let computed = crc32fast::hash(covered);
+        if stored != computed {
+            return Err(bad(
+                path,
+                format!(
+                    "the checkpoint is damaged: the CRC-32 of its {} bytes is {computed:08x}, \
+                     the stored one {stored:08x}",
+                    covered.len()
+                ),
+            ));
+        }
+        let (c, trailing): (Self, &[u8]) = postcard::take_from_bytes(&covered[MAGIC.len()..])
+            .map_err(|e| bad(path, format!("cannot decode the checkpoint: {e}")))?;
+        if !trailing.is_empty() {
             return Err(bad(path, "trailing bytes after the checkpoint".into()));
         }
         Ok(c)

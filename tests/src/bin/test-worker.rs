@@ -2,9 +2,8 @@
 //! Prints `LISTENING <addr>` on stdout once bound. (The real binary is `cosdem-worker`.)
 
 use clap::Parser;
-use cosdem_worker::{
-    ListenArgs, StandIn, StandInOptions, WorkerConfig, bind, serve_listener, shutdown_signal,
-};
+use cosdem_worker::{StandIn, StandInOptions, WorkerConfig, bind, serve_listener, shutdown_signal};
+use cosdem_worker_cli::ListenArgs;
 use std::io::Write;
 use std::time::Duration;
 

@@ -1,14 +1,18 @@
 //! `cosdem-worker`: the DEM worker binary.
 //!
 //! ```text
-//! cosdem-worker listen --listen 0.0.0.0:7700 [--token-file FILE] [--threads N]
-//! cosdem-worker health --addr HOST:PORT
+//! cosdem-worker listen [--listen ADDR] [--token-file FILE] [--threads N]
+//! cosdem-worker health [--addr HOST:PORT]
 //! cosdem-worker bench dem [--quick]
 //! ```
+//!
+//! Both default to `127.0.0.1:7700`, the port of the docs and the deploy recipes; a worker
+//! for other hosts listens on `0.0.0.0:7700` with a token.
 
 use anyhow::Result;
 use clap::{Parser, Subcommand};
 use cosdem_dem::BoundarySpec;
+use cosdem_worker_cli::ListenArgs;
 
 /// The cosdem DEM worker.
 #[derive(Parser, Debug)]
@@ -21,7 +25,7 @@ struct Cli {
 #[derive(Subcommand, Debug)]
 enum Command {
     /// Serve DEM assemblies over gRPC until SIGTERM / Ctrl-C.
-    Listen(cosdem_worker::ListenArgs),
+    Listen(ListenArgs),
     /// Exit 0 iff the worker at `--addr` reports SERVING (for container health checks).
     Health {
         /// `host:port` of the worker.
@@ -108,13 +112,17 @@ fn bench_dem(quick: bool) -> Result<()> {
     Ok(())
 }
 
-fn listen(args: cosdem_worker::ListenArgs) -> Result<()> {
+fn listen(args: ListenArgs) -> Result<()> {
     use cosdem_worker::{Dem, WorkerConfig, serve, shutdown_signal};
+    use std::io::IsTerminal;
+    // The log goes to stderr, which the deploy recipes send to a file (Slurm's job output,
+    // `2> worker.log`, a container's log): colour codes only when it is a terminal.
     tracing_subscriber::fmt()
         .with_env_filter(
             tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "info".into()),
         )
         .with_writer(std::io::stderr)
+        .with_ansi(std::io::stderr().is_terminal())
         .init();
     let config: WorkerConfig = args.try_into()?;
     let runtime = tokio::runtime::Builder::new_multi_thread().enable_all().build()?;

@@ -31,6 +31,8 @@ pub mod broadphase;
 pub mod contact;
 /// The crate's error type.
 pub mod error;
+/// The fluctuation field (Eq. 35) and the affine fit of a deformed assembly.
+pub mod fluctuation;
 /// Homogenized stress, tangents and fabric.
 pub mod homogenize;
 /// Leapfrog integration, time step, Cundall and FIRE relaxation.

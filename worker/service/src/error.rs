@@ -33,6 +33,16 @@ pub enum ServiceError {
     /// The model refused a spec or a state.
     #[error("{0}")]
     Model(#[from] ModelError),
+    /// An exported state that does not make an assembly (ImportState), with the Gauss point
+    /// it was sent for: the decoder names only the part at fault (header, checksum, spec,
+    /// body), and one request may carry many states.
+    #[error("assembly {id}: {reason}")]
+    Import {
+        /// The Gauss point the state was sent for.
+        id: GaussPointId,
+        /// Why the model refused it (in the message, so not a `source()` as well).
+        reason: ModelError,
+    },
     /// A bug or a lost background task.
     #[error("internal error: {0}")]
     Internal(String),
@@ -57,10 +67,12 @@ impl From<ServiceError> for Status {
             ServiceError::VersionMismatch { .. } => Status::failed_precondition(msg),
             ServiceError::ResourceExhausted(_) => Status::resource_exhausted(msg),
             ServiceError::FailedPrecondition(_) => Status::failed_precondition(msg),
-            ServiceError::Model(ModelError::InvalidSpec(_) | ModelError::InvalidState(_)) => {
-                Status::invalid_argument(msg)
-            }
-            ServiceError::Model(ModelError::Failed(_)) => Status::internal(msg),
+            ServiceError::Model(m) | ServiceError::Import { reason: m, .. } => match m {
+                ModelError::InvalidSpec(_) | ModelError::InvalidState(_) => {
+                    Status::invalid_argument(msg)
+                }
+                ModelError::Failed(_) => Status::internal(msg),
+            },
             ServiceError::Internal(_) | ServiceError::Config(_) | ServiceError::Transport(_) => {
                 Status::internal(msg)
             }

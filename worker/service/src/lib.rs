@@ -13,6 +13,9 @@
 //!   missing or wrong token UNAUTHENTICATED. A failed relaxation is not a status: it comes
 //!   back in-band in its `SolveResult`.
 //! - TLS (feature `tls`, rustls with ring): [`WorkerConfig::tls`] / `--tls-cert --tls-key`.
+//!
+//! The `cosdem-worker` binary and its command line are the `cosdem-worker-cli` package: this
+//! library depends on no clap, anyhow or tracing-subscriber.
 
 mod auth;
 mod config;
@@ -25,7 +28,7 @@ mod server;
 mod standin;
 
 pub use auth::{AttachToken, CheckToken, TOKEN_ENV, Token};
-pub use config::{Limits, ListenArgs, TlsIdentity, WorkerConfig};
+pub use config::{Limits, TlsIdentity, WorkerConfig};
 pub use dem::Dem;
 pub use error::{Result, ServiceError};
 pub use model::{MicroModel, ModelError};

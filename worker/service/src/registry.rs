@@ -155,11 +155,15 @@ impl<M: MicroModel> Registry<M> {
         Ok(std::iter::once((*first, a)).chain(rest).collect())
     }
 
-    /// Creates or replaces assemblies from exported committed states; all or nothing.
+    /// Creates or replaces assemblies from exported committed states; all or nothing. A state
+    /// the model refuses is reported with the Gauss point it was sent for.
     pub fn import(&self, states: Vec<AssemblyState>) -> Result<Vec<AssemblyInfo>> {
         let mut built = Vec::with_capacity(states.len());
         for s in states {
-            let a = self.model.import(&s.state)?;
+            let a = self
+                .model
+                .import(&s.state)
+                .map_err(|reason| ServiceError::Import { id: s.id, reason })?;
             built.push((s.id, s.committed_step, a));
         }
         let mut entries = lock(&self.entries);

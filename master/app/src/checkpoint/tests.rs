@@ -1,40 +1,37 @@
 //! Resume is bit-identical: a small DEM job (the quick panel reduced to one element, 4 Gauss
 //! points, 4 steps) run straight through, and the same job stopped after step 2 (as Ctrl-C
 //! does) and resumed from its checkpoint in fresh solver, pool and writer objects, write
-//! byte-identical `curve.csv` and `.pvd` series.
+//! byte-identical `curve.csv` and `.pvd` series. The file format: a bit-exact round trip, every
+//! flipped bit refused with the file named, older and foreign files refused by name.
 
 use super::*;
 use crate::output::run_dir::{RunSettings, RunWriter};
-use cosdem_common::micro::{AssemblyRequest, BoundaryKind};
-use cosdem_pool::{Pool, PoolConfig};
-use cosdem_worker::Dem;
+use crate::run::{WorkerChoice, gauss_point_ids, material_for};
+use cosdem_job::{MaterialSection, fixtures};
+use cosdem_pool::PoolConfig;
+use std::collections::BTreeMap;
 
-const JOB: &str = r#"
-    [mesh]
-    kind = "rectangle"
-    lx = 1.0
-    ly = 1.0
-    nx = 1
-    ny = 1
-    [loading]
-    steps = 4
-    [loading.compression]
-    displacement = 0.008
-    [[loading.pressure]]
-    set = "left"
-    value = 1.0e5
-    [[loading.pressure]]
-    set = "right"
-    value = 1.0e5
-    [newton]
-    force_tolerance = 5.0e-3
-    displacement_tolerance = 5.0e-3
-    max_iterations = 20
-    [material]
-    kind = "dem"
-    [material.assembly]
-    packing = { kind = "hexagonal", radius = 0.005, side = 0.06 }
-"#;
+/// The `dem-one-element` fixture (one Q8 element, 4 hexagonal assemblies) compressed by 8 mm
+/// in 4 steps, with smaller assemblies (side 0.06 m).
+fn small_job() -> Job {
+    let mut job = fixtures::load("dem-one-element");
+    job.loading.steps = 4;
+    job.loading.compression.as_mut().unwrap().displacement = 0.008;
+    let MaterialSection::Dem { assembly } = &mut job.material else { panic!("a DEM job") };
+    let cosdem_dem::PackingSpec::Hexagonal { side, .. } = &mut assembly.packing else {
+        panic!("a hexagonal packing")
+    };
+    *side = 0.06;
+    job.validate().unwrap();
+    job
+}
+
+/// `small_job` with another compression: another job to a checkpoint.
+fn displaced(displacement: f64) -> Job {
+    let mut job = small_job();
+    job.loading.compression.as_mut().unwrap().displacement = displacement;
+    job
+}
 
 fn settings(job: &Job) -> RunSettings {
     RunSettings {
@@ -48,29 +45,15 @@ fn settings(job: &Job) -> RunSettings {
     }
 }
 
-fn pool(job: &Job, ids: &[GaussPointId], states: Option<Vec<AssemblyState>>) -> Pool {
+/// The job's material on one in-process worker of one thread: new assemblies, or `states`.
+fn dem_material(
+    job: &Job,
+    ids: &[GaussPointId],
+    states: Option<Vec<AssemblyState>>,
+) -> Box<dyn Material> {
     let config = PoolConfig { in_process_threads: 1, ..PoolConfig::default() };
-    let mut pool = Pool::in_process(1, config, |_| Dem).unwrap();
-    match states {
-        Some(s) => pool.restore_states(s).unwrap(),
-        None => {
-            let cosdem_job::MaterialSection::Dem { assembly } = &job.material else { panic!() };
-            let req = AssemblyRequest {
-                spec_json: serde_json::to_vec(assembly).unwrap(),
-                boundary: BoundaryKind::Unspecified,
-                disc_count_hint: 0,
-            };
-            pool.create_assemblies(ids, &req).unwrap();
-        }
-    }
-    pool
-}
-
-fn ids(solver: &Solver) -> Vec<GaussPointId> {
-    let per = solver.gauss().per_element as u32;
-    (0..solver.model().mesh.n_elements() as u32)
-        .flat_map(|e| (0..per).map(move |p| GaussPointId::new(e, p)))
-        .collect()
+    let workers = WorkerChoice { addresses: Vec::new(), config };
+    material_for(job, &workers, ids, states).unwrap().0
 }
 
 /// Sets the stop flag once step `at` is observed (what Ctrl-C during that step does).
@@ -96,26 +79,29 @@ fn run(dir: &Path, job: &Job, stop_at: u64, resume: bool) -> Result<()> {
 
 fn run_with(dir: &Path, job: &Job, stop_at: u64, resume: bool, newton_changed: bool) -> Result<()> {
     let mut solver = Solver::new(job.model()?, job.solver_settings()?)?;
-    let ids = ids(&solver);
+    let ids = gauss_point_ids(&solver);
     let (mut writer, mut material) = if resume {
         let c = Checkpoint::read(&dir.join(FILE))?;
         c.check_job(job, dir, newton_changed)?;
         let states = c.assembly_states();
         let step = c.solver.step;
         solver.restore(c.solver)?;
-        (RunWriter::resume(dir, settings(job), step).unwrap(), pool(job, &ids, Some(states)))
+        (
+            RunWriter::resume(dir, settings(job), step).unwrap(),
+            dem_material(job, &ids, Some(states)),
+        )
     } else {
-        (RunWriter::create(dir, settings(job)).unwrap(), pool(job, &ids, None))
+        (RunWriter::create(dir, settings(job)).unwrap(), dem_material(job, &ids, None))
     };
     let flag = Arc::new(AtomicBool::new(false));
     let inner = StopAt { writer: &mut writer, at: stop_at, flag: flag.clone() };
     let mut obs = Checkpointer::new(inner, dir, 1, job, flag);
-    solver.run(&mut material, &mut obs).map(|_| ())
+    solver.run(material.as_mut(), &mut obs).map(|_| ())
 }
 
 #[test]
 fn stopped_and_resumed_run_is_bit_identical() {
-    let job = Job::from_toml(JOB, "small").unwrap();
+    let job = small_job();
     let base = std::env::temp_dir().join(format!("cosdem-ckpt-{}", std::process::id()));
     let (straight, resumed) = (base.join("straight"), base.join("resumed"));
     run(&straight, &job, u64::MAX, false).unwrap();
@@ -131,9 +117,22 @@ fn stopped_and_resumed_run_is_bit_identical() {
     }
     assert_eq!(std::fs::read_to_string(straight.join("curve.csv")).unwrap().lines().count(), 5);
     // A changed job is refused.
-    let other = Job::from_toml(&JOB.replace("0.008", "0.009"), "other").unwrap();
+    let other = displaced(0.009);
     let c = Checkpoint::read(&resumed.join(FILE)).unwrap();
     assert!(c.check_job(&other, &resumed, true).unwrap_err().to_string().contains("another job"));
+    // A real checkpoint (four assembly states): a deterministic sample of 400 single-bit flips
+    // spread over the whole file (a stride prime to its length in bits) is refused.
+    let path = resumed.join(FILE);
+    let good = std::fs::read(&path).unwrap();
+    let n = 8 * good.len();
+    for k in 0..400 {
+        let bit = (k * 7919 + k / 3) % n;
+        let mut b = good.clone();
+        b[bit / 8] ^= 1 << (bit % 8);
+        std::fs::write(&path, &b).unwrap();
+        let e = Checkpoint::read(&path).unwrap_err().to_string();
+        assert!(e.contains("damaged") && e.contains(FILE), "bit {bit} of {n}: {e}");
+    }
     std::fs::remove_dir_all(&base).unwrap();
 }
 
@@ -142,12 +141,9 @@ fn stopped_and_resumed_run_is_bit_identical() {
 /// force tolerance tightened by 10^3, so they take more iterations than the straight run's.
 #[test]
 fn a_resume_may_change_the_newton_settings_when_asked() {
-    let job = Job::from_toml(JOB, "small").unwrap();
-    let tight = Job::from_toml(
-        &JOB.replace("force_tolerance = 5.0e-3", "force_tolerance = 5.0e-6"),
-        "tight",
-    )
-    .unwrap();
+    let job = small_job();
+    let mut tight = small_job();
+    tight.newton.force_tolerance = 5.0e-6;
     assert_eq!(job_digest(&job), job_digest(&tight), "newton is not the physics digest's");
     let base = std::env::temp_dir().join(format!("cosdem-ckpt-newton-{}", std::process::id()));
     let (straight, resumed) = (base.join("straight"), base.join("resumed"));
@@ -176,17 +172,116 @@ fn a_resume_may_change_the_newton_settings_when_asked() {
     std::fs::remove_dir_all(&base).unwrap();
 }
 
-/// A file of the first format, or none of ours, is refused with an error that says which.
+/// A small checkpoint whose floats are the awkward ones: signed zeros, a subnormal, the
+/// extremes, an infinity and a NaN with a payload (a lossy float encoding would change them).
+fn awkward() -> Checkpoint {
+    let u = vec![
+        0.0,
+        -0.0,
+        1.0 / 3.0,
+        f64::MIN_POSITIVE / 3.0,
+        f64::MAX,
+        f64::NEG_INFINITY,
+        f64::from_bits(0x7ff8_dead_beef_0001),
+        -1e-300,
+    ];
+    Checkpoint {
+        digests: Digests { job: 0x0123_4567_89ab_cdef, newton: u64::MAX },
+        solver: SolverState {
+            u,
+            lambda: 0.1 + 0.2,
+            step: 3,
+            increment: 1e-3,
+            committed: None,
+            gauss_points: Vec::new(),
+            reactions: BTreeMap::from([("top".to_string(), [1.5, -0.0, 7e-310])]),
+        },
+        assemblies: vec![SavedAssembly {
+            id: GaussPointId::new(0, 3),
+            committed_step: 3,
+            disc_count: 2,
+            state: (0u8..40).collect(),
+        }],
+    }
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("cosdem-ckpt-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Written and read back, a checkpoint is the same bit for bit (no tolerance: postcard writes
+/// each f64 as its 8 bytes; compared through the bit patterns, as a NaN is not equal to
+/// itself).
+#[test]
+fn round_trip_is_bit_exact() {
+    let dir = scratch("roundtrip");
+    let path = dir.join(FILE);
+    let c = awkward();
+    c.write(&path).unwrap();
+    let bytes = std::fs::read(&path).unwrap();
+    assert_eq!(&bytes[..8], b"CDEMCKP4");
+    let back = Checkpoint::read(&path).unwrap();
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&back.solver.u), bits(&c.solver.u));
+    assert_eq!(back.solver.lambda.to_bits(), c.solver.lambda.to_bits());
+    assert_eq!(
+        back.solver.reactions["top"].map(f64::to_bits),
+        [1.5, -0.0, 7e-310].map(f64::to_bits)
+    );
+    assert_eq!((back.digests, back.solver.step, &back.assemblies), (c.digests, 3, &c.assemblies));
+    back.write(&path).unwrap();
+    assert_eq!(std::fs::read(&path).unwrap(), bytes, "re-encoding gives the same bytes");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Every single-bit flip of a small checkpoint is refused with the file named: in the header
+/// as a damaged or foreign header (never as an older format: version 4 is two bits from the
+/// older ones), in the body and in the checksum itself by the checksum. All bits are tried.
+#[test]
+fn every_flipped_bit_is_refused_naming_the_file() {
+    let dir = scratch("flips");
+    let path = dir.join(FILE);
+    awkward().write(&path).unwrap();
+    let good = std::fs::read(&path).unwrap();
+    for bit in 0..8 * good.len() {
+        let mut b = good.clone();
+        b[bit / 8] ^= 1 << (bit % 8);
+        std::fs::write(&path, &b).unwrap();
+        let e = Checkpoint::read(&path).unwrap_err().to_string();
+        assert!(e.contains(&path.display().to_string()), "bit {bit}: {e}");
+        if bit < 64 {
+            assert!(e.contains("no CDEMCKP4 header") && e.contains("damaged"), "bit {bit}: {e}");
+        } else {
+            assert!(e.contains("damaged: the CRC-32"), "bit {bit}: {e}");
+        }
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A checkpoint of the older bincode formats, or a file that is none of ours, is refused with
+/// an error that says which.
 #[test]
 fn old_and_foreign_files_are_refused_by_name() {
-    let dir = std::env::temp_dir().join(format!("cosdem-ckpt-format-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch("format");
     let path = dir.join(FILE);
-    std::fs::write(&path, b"CDEMCKP1 and whatever followed").unwrap();
-    let old = Checkpoint::read(&path).unwrap_err().to_string();
-    assert!(old.contains("first format") && old.contains("CDEMCKP1"), "{old}");
+    for old in ["CDEMCKP1", "CDEMCKP2"] {
+        std::fs::write(&path, format!("{old} and whatever bincode followed")).unwrap();
+        let e = Checkpoint::read(&path).unwrap_err().to_string();
+        assert!(
+            e.contains(old)
+                && e.contains("older bincode format of an earlier cosdem")
+                && e.contains("must be restarted")
+                && e.contains(FILE),
+            "{e}"
+        );
+    }
     std::fs::write(&path, b"PK\x03\x04 a zip file").unwrap();
     let foreign = Checkpoint::read(&path).unwrap_err().to_string();
     assert!(foreign.contains("not a cosdem checkpoint"), "{foreign}");
+    std::fs::write(&path, b"CDEMCKP4").unwrap();
+    let short = Checkpoint::read(&path).unwrap_err().to_string();
+    assert!(short.contains("truncated"), "{short}");
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -1,10 +1,36 @@
+//! An assembly's bytes (what a worker exports, a checkpoint stores and a migration carries)
+//! and its snapshots.
+//!
+//! Format `CDEMASM4`: the 8-byte header `CDEMASM4`; the spec as JSON (its tagged enums need a
+//! self-describing format) after its length as a little-endian `u64`; the state (contact law,
+//! reference, time step, committed and trial state) in postcard, whose wire format is
+//! specified and writes every `f64` as its 8 little-endian bytes, so a state reads back bit
+//! for bit; and last a CRC-32 (IEEE, little-endian) of every byte before it.
+//!
+//! The checksum is a CRC-32 (`crc32fast`) rather than a 64-bit hash: it is guaranteed to
+//! catch every single-bit error and every burst of up to 32 bits (what a damaged disk block or
+//! a bad copy does), it is the standard polynomial that any zlib can recompute, and it runs at
+//! memory speed; an accidental match of a randomly damaged state (2^-32) is no concern for a
+//! check against damage (it is not meant to stop tampering).
+//!
+//! The version is 4, not 3: `'3'` is one bit from the older `'2'` and `'1'`, so a flipped bit
+//! in a new header could pass for an older format and draw the wrong error; `'4'` is two bits
+//! from either.
+
 use super::Assembly;
 use crate::error::{Error, Result};
 use crate::homogenize::for_each_contact;
 use cosdem_common::micro::MicroSnapshot;
 use serde::{Deserialize, Serialize};
 
-const MAGIC: &[u8; 8] = b"CDEMASM2";
+/// The header of the format written (postcard and a CRC-32).
+const MAGIC: &[u8; 8] = b"CDEMASM4";
+
+/// The headers of the formats of earlier cosdems (bincode, no checksum): refused by name.
+const OLD_MAGICS: [&[u8; 8]; 2] = [b"CDEMASM1", b"CDEMASM2"];
+
+/// Bytes of the trailing CRC-32.
+const CRC_LEN: usize = 4;
 
 /// One active contact in a snapshot.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -67,9 +93,8 @@ struct Body {
 }
 
 impl Assembly {
-    /// Encodes spec, reference, committed and trial state: the header `CDEMASM2`, the spec
-    /// as length-prefixed JSON (its tagged enums need a self-describing format), then the
-    /// state in bincode 2 (f64 as raw little-endian bit patterns: bit-exact).
+    /// Encodes spec, reference, committed and trial state (the format is described at the
+    /// top of this module).
     pub fn to_bytes(&self) -> Vec<u8> {
         let mut out = MAGIC.to_vec();
         // Encoding plain data into memory cannot fail.
@@ -83,37 +108,67 @@ impl Assembly {
             committed: self.committed.clone(),
             trial: self.trial.clone(),
         };
-        let body = bincode::serde::encode_to_vec(&body, bincode::config::standard())
-            .expect("encoding an assembly into memory");
+        let body = postcard::to_allocvec(&body).expect("encoding an assembly into memory");
         out.extend_from_slice(&body);
+        let crc = crc32fast::hash(&out);
+        out.extend_from_slice(&crc.to_le_bytes());
         out
     }
 
-    /// Restores an assembly encoded by [`Assembly::to_bytes`], bit for bit.
+    /// Restores an assembly encoded by [`Assembly::to_bytes`], bit for bit. Refuses, with the
+    /// part at fault named, bytes of another format (the older bincode formats by name), a
+    /// checksum that does not match (a flipped bit anywhere), and a spec or state that does
+    /// not make an assembly.
     pub fn from_bytes(bytes: &[u8]) -> Result<Assembly> {
         let m = MAGIC.len();
-        if bytes.len() < m + 8 || &bytes[..m] != MAGIC {
-            return Err(Error::Decode("missing CDEMASM2 header".into()));
+        let head = &bytes[..m.min(bytes.len())];
+        if let Some(old) = OLD_MAGICS.iter().find(|o| head == o.as_slice()) {
+            return Err(Error::Decode(format!(
+                "header: {} is the older bincode format of an earlier cosdem, which this cosdem \
+                 no longer reads; the run must be restarted",
+                String::from_utf8_lossy(&old[..])
+            )));
         }
-        let len = u64::from_le_bytes(bytes[m..m + 8].try_into().expect("8 bytes")) as usize;
-        let rest = &bytes[m + 8..];
+        if head != MAGIC {
+            return Err(Error::Decode(format!(
+                "header: no {} header (not a cosdem assembly state, or its header is damaged)",
+                String::from_utf8_lossy(MAGIC)
+            )));
+        }
+        if bytes.len() < m + 8 + CRC_LEN {
+            return Err(Error::Decode(format!("{} bytes: too short for a state", bytes.len())));
+        }
+        let (covered, crc) = bytes.split_at(bytes.len() - CRC_LEN);
+        let stored = u32::from_le_bytes(crc.try_into().expect("4 bytes"));
+        let computed = crc32fast::hash(covered);
+        if stored != computed {
+            return Err(Error::Decode(format!(
+                "checksum: CRC-32 {computed:08x} of the {} bytes does not match the stored \
+                 {stored:08x} (the state was damaged)",
+                covered.len()
+            )));
+        }
+        let len = u64::from_le_bytes(covered[m..m + 8].try_into().expect("8 bytes")) as usize;
+        let rest = &covered[m + 8..];
         if len > rest.len() {
             return Err(Error::Decode(format!(
-                "spec length {len} beyond the {} bytes left",
+                "spec: length {len} beyond the {} bytes left",
                 rest.len()
             )));
         }
-        let spec: crate::spec::AssemblySpec =
-            serde_json::from_slice(&rest[..len]).map_err(|e| Error::Decode(e.to_string()))?;
+        let spec: crate::spec::AssemblySpec = serde_json::from_slice(&rest[..len])
+            .map_err(|e| Error::Decode(format!("spec: {e}")))?;
         spec.validate()?;
-        let (body, used): (Body, usize) =
-            bincode::serde::decode_from_slice(&rest[len..], bincode::config::standard())
-                .map_err(|e| Error::Decode(e.to_string()))?;
-        if len + used != rest.len() {
-            return Err(Error::Decode(format!("{} trailing bytes", rest.len() - len - used)));
+        let (body, trailing): (Body, &[u8]) = postcard::take_from_bytes(&rest[len..])
+            .map_err(|e| Error::Decode(format!("state body: {e}")))?;
+        if !trailing.is_empty() {
+            return Err(Error::Decode(format!("state body: {} trailing bytes", trailing.len())));
         }
         if !(body.dt.is_finite() && body.dt > 0.0) {
-            return Err(Error::Decode(format!("time step {} is not positive and finite", body.dt)));
+            return Err(Error::Decode(format!(
+                "dt: time step {} is not positive and finite",
+                body.dt
+            )));
         }
         let n = body.refc.r.len();
         let ok = |st: &super::State| {
@@ -134,7 +189,7 @@ impl Assembly {
             [&refc.inv_m, &refc.inv_i, &refc.x0, &refc.y0, &refc.th0].iter().all(|v| v.len() == n)
                 && refc.boundary.iter().all(|&k| (k as usize) < n);
         if !sizes || !ok(&body.committed) || !body.trial.as_ref().is_none_or(ok) {
-            return Err(Error::Decode("inconsistent array sizes".into()));
+            return Err(Error::Decode("state body: inconsistent array sizes".into()));
         }
         Ok(Assembly {
             spec,
@@ -171,61 +226,20 @@ impl Assembly {
         }
     }
 
-    /// Fluctuation field of a state, Eq. 35.
+    /// Fluctuation field of a state, Eq. 35 ([`crate::fluctuation::fluctuation`]).
     pub fn fluctuation(&self, st: &super::State) -> Vec<[f64; 2]> {
-        let f = &st.target.f;
-        let (x0, y0, xc) = (&self.refc.x0, &self.refc.y0, self.refc.xc);
-        (0..self.disc_count())
-            .map(|q| {
-                let (dx, dy) = (x0[q] - xc[0], y0[q] - xc[1]);
-                let ux = st.dynamics.x[q] - x0[q];
-                let uy = st.dynamics.y[q] - y0[q];
-                [
-                    ux - ((f[0][0] - 1.0) * dx + f[0][1] * dy),
-                    uy - (f[1][0] * dx + (f[1][1] - 1.0) * dy),
-                ]
-            })
-            .collect()
+        let d = &st.dynamics;
+        let r = &self.refc;
+        crate::fluctuation::fluctuation(&st.target.f, &r.x0, &r.y0, r.xc, &d.x, &d.y)
     }
 
     /// Best affine fit `x = c + G (X - X_c)` of the discs outside the boundary layer (all
-    /// discs for a periodic boundary); returns `G`, the measured deformation gradient.
+    /// discs for a periodic boundary); returns `G`, the measured deformation gradient
+    /// ([`crate::fluctuation::affine_fit`]).
     pub fn affine_fit(&self, st: &super::State) -> [[f64; 2]; 2] {
-        let mut inb = vec![false; self.disc_count()];
-        for &q in &self.refc.boundary {
-            inb[q as usize] = true;
-        }
-        let (x0, y0, xc) = (&self.refc.x0, &self.refc.y0, self.refc.xc);
-        let (mut n, mut mx, mut my, mut mxx, mut myy) = (0.0, 0.0, 0.0, 0.0, 0.0);
-        for q in 0..self.disc_count() {
-            if inb[q] {
-                continue;
-            }
-            n += 1.0;
-            mx += x0[q] - xc[0];
-            my += y0[q] - xc[1];
-            mxx += st.dynamics.x[q];
-            myy += st.dynamics.y[q];
-        }
-        let (mx, my, mxx, myy) = (mx / n, my / n, mxx / n, myy / n);
-        let (mut a, mut b, mut c) = (0.0, 0.0, 0.0);
-        let mut rhs = [[0.0; 2]; 2];
-        for q in 0..self.disc_count() {
-            if inb[q] {
-                continue;
-            }
-            let (px, py) = (x0[q] - xc[0] - mx, y0[q] - xc[1] - my);
-            let (ux, uy) = (st.dynamics.x[q] - mxx, st.dynamics.y[q] - myy);
-            a += px * px;
-            b += px * py;
-            c += py * py;
-            rhs[0][0] += ux * px;
-            rhs[0][1] += ux * py;
-            rhs[1][0] += uy * px;
-            rhs[1][1] += uy * py;
-        }
-        let inv = crate::boundary::mat_inv(&[[a, b], [b, c]]);
-        crate::boundary::mat_mul(&rhs, &inv)
+        let d = &st.dynamics;
+        let r = &self.refc;
+        crate::fluctuation::affine_fit(&r.x0, &r.y0, r.xc, &r.boundary, &d.x, &d.y)
     }
 
     /// Boundary-average stress `(1/A) sum_q (x_q - X_c)_i f_q,j` over the penalty forces
@@ -266,5 +280,92 @@ impl Assembly {
                 mx.abs() < half && my.abs() < half
             },
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use cosdem_common::MacroDeformation;
+
+    /// A small relaxed assembly with a trial state on top of its committed one, so that both
+    /// states, the contact histories and the spec are in the bytes.
+    fn small() -> Assembly {
+        let spec: crate::AssemblySpec = serde_json::from_value(serde_json::json!({
+            "packing": {"kind": "hexagonal", "radius": 0.005, "side": 0.04},
+            "relaxation": {"max_steps": 2000}
+        }))
+        .unwrap();
+        let mut a = Assembly::new(&spec).unwrap();
+        let f = |e| MacroDeformation::from_gradient([[0.0, 0.0], [0.0, e]], 0.0, [0.0; 2]);
+        a.solve(&f(-1e-3)).unwrap();
+        a.commit();
+        a.solve(&f(-2e-3)).unwrap();
+        a
+    }
+
+    fn bits(v: &[f64]) -> Vec<u64> {
+        v.iter().map(|x| x.to_bits()).collect()
+    }
+
+    /// Encoded and decoded, an assembly is the same bit for bit: its re-encoding is the same
+    /// bytes, and the evolving arrays hold the same f64 bit patterns (no tolerance: postcard
+    /// writes each f64 as its 8 bytes).
+    #[test]
+    fn round_trip_is_bit_exact() {
+        let a = small();
+        let bytes = a.to_bytes();
+        assert_eq!(&bytes[..8], MAGIC);
+        let b = Assembly::from_bytes(&bytes).unwrap();
+        assert_eq!(b.to_bytes(), bytes);
+        for (s, t) in [(&a.committed, &b.committed), (a.trial().unwrap(), b.trial().unwrap())] {
+            assert_eq!(bits(&s.dynamics.x), bits(&t.dynamics.x));
+            assert_eq!(bits(&s.dynamics.th), bits(&t.dynamics.th));
+            assert_eq!(bits(&s.pairs.fs), bits(&t.pairs.fs));
+            assert_eq!(s, t);
+        }
+        assert_eq!(a.refc, b.refc);
+        assert_eq!(a.dt.to_bits(), b.dt.to_bits());
+    }
+
+    /// Every single-bit flip of a small state, in the header, the spec length, the spec, the
+    /// postcard body and the checksum itself, is refused, and the error names the part at
+    /// fault: the header (a flip there makes no header of ours; never an older format's, so
+    /// never the restart message), else the checksum. All bits are tried.
+    #[test]
+    fn every_flipped_bit_is_refused() {
+        let bytes = small().to_bytes();
+        assert!(bytes.len() < 64 * 1024, "a small state: {} bytes", bytes.len());
+        let mut b = bytes.clone();
+        for bit in 0..8 * bytes.len() {
+            let (i, mask) = (bit / 8, 1u8 << (bit % 8));
+            b[i] ^= mask;
+            let e = Assembly::from_bytes(&b).map(|_| ()).unwrap_err().to_string();
+            if i < MAGIC.len() {
+                assert!(e.contains("header: no CDEMASM4 header"), "bit {bit}: {e}");
+            } else {
+                assert!(e.contains("checksum: CRC-32"), "bit {bit}: {e}");
+            }
+            b[i] ^= mask;
+        }
+        assert_eq!(b, bytes);
+        assert!(Assembly::from_bytes(&b).is_ok());
+    }
+
+    /// The states of an earlier cosdem (bincode, headers `CDEMASM1` and `CDEMASM2`) are
+    /// refused by name, with what to do.
+    #[test]
+    fn older_formats_are_refused_by_name() {
+        for old in ["CDEMASM1", "CDEMASM2"] {
+            let mut b = old.as_bytes().to_vec();
+            b.extend_from_slice(&[0x2a; 64]);
+            let e = Assembly::from_bytes(&b).map(|_| ()).unwrap_err().to_string();
+            assert!(
+                e.contains(old) && e.contains("older bincode format") && e.contains("restarted"),
+                "{e}"
+            );
+        }
+        let e = Assembly::from_bytes(b"CDEMASM4").map(|_| ()).unwrap_err().to_string();
+        assert!(e.contains("too short"), "{e}");
     }
 }
