@@ -3,13 +3,11 @@
 
 mod common;
 use common::*;
-use cosdem_pool::Pool;
-use cosdem_worker::StandIn;
 
 #[test]
 fn in_process_one_and_three_workers_agree() {
     let reference = reference(100, 20);
-    let mut pool = Pool::in_process(3, test_config(), |_| StandIn::new()).unwrap();
+    let mut pool = standin_pool(3, test_config());
     create(&mut pool, 100, 20);
     let workers: std::collections::BTreeSet<_> = pool.assignment().into_values().collect();
     assert_eq!(workers.len(), 3, "assemblies spread over the three workers");
@@ -21,9 +19,7 @@ fn in_process_one_and_three_workers_agree() {
 fn one_and_three_worker_processes_agree_with_in_process() {
     let reference = reference(100, 20);
     for n in [1, 3] {
-        let procs: Vec<_> = (0..n).map(|_| WorkerProcess::start(&[], &[])).collect();
-        let addrs: Vec<String> = procs.iter().map(|p| p.addr.to_string()).collect();
-        let mut pool = Pool::connect(&addrs, test_config()).unwrap();
+        let (_procs, mut pool) = process_pool(n, test_config());
         assert_eq!(pool.live_workers(), n);
         create(&mut pool, 100, 20);
         let trace = run_program(&mut pool, &mut |_, _| {});

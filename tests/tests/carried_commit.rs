@@ -7,7 +7,7 @@
 mod common;
 use common::*;
 use cosdem_common::{GaussPointId, MacroDeformation};
-use cosdem_pool::{Pool, PoolConfig};
+use cosdem_pool::PoolConfig;
 use cosdem_proto::v1 as pb;
 use cosdem_proto::v1::micro_solver_client::MicroSolverClient;
 use cosdem_worker::{StandIn, WorkerConfig};
@@ -118,7 +118,7 @@ fn config(defer_commits: bool) -> PoolConfig {
 fn carried_commits_give_bit_identical_runs() {
     let run = |defer: bool, workers: usize, duplex: bool| {
         let c = PoolConfig { in_process_duplex: duplex, ..config(defer) };
-        let mut pool = Pool::in_process(workers, c, |_| StandIn::new()).unwrap();
+        let mut pool = standin_pool(workers, c);
         create(&mut pool, 100, 20);
         let trace = run_program(&mut pool, &mut |_, _| {});
         (trace, pool.stats())
@@ -137,9 +137,7 @@ fn carried_commits_give_bit_identical_runs() {
 #[test]
 fn a_worker_killed_while_holding_an_unsent_commit_is_restored_identically() {
     let reference = reference(100, 20);
-    let mut procs: Vec<_> = (0..2).map(|_| WorkerProcess::start(&[], &[])).collect();
-    let addrs: Vec<String> = procs.iter().map(|p| p.addr.to_string()).collect();
-    let mut pool = Pool::connect(&addrs, config(true)).unwrap();
+    let (mut procs, mut pool) = process_pool(2, config(true));
     create(&mut pool, 100, 20);
     let mut killed = false;
     let trace = run_program(&mut pool, &mut |step, iteration| {

@@ -5,12 +5,10 @@ mod common;
 use common::*;
 use cosdem_common::{GaussPointId, MacroDeformation};
 use cosdem_fem::material::{Material, MaterialError, MaterialInput, TrialId};
-use cosdem_pool::Pool;
-use cosdem_worker::StandIn;
 
 #[test]
 fn failed_relaxation_names_the_gauss_point() {
-    let mut pool = Pool::in_process(2, test_config(), |_| StandIn::new()).unwrap();
+    let mut pool = standin_pool(2, test_config());
     create(&mut pool, 10, 1);
     let bad = GaussPointId::new(2, 1);
     let inputs = |e_bad: f64| -> Vec<MaterialInput> {

@@ -3,14 +3,12 @@
 
 mod common;
 use common::*;
-use cosdem_pool::{Pool, PoolConfig};
+use cosdem_pool::PoolConfig;
 
 /// Kills worker 0 mid-step 2 and worker 1 after step 4's last iteration.
 fn kill_two(config: PoolConfig) {
     let reference = reference(100, 20);
-    let mut procs: Vec<_> = (0..3).map(|_| WorkerProcess::start(&[], &[])).collect();
-    let addrs: Vec<String> = procs.iter().map(|p| p.addr.to_string()).collect();
-    let mut pool = Pool::connect(&addrs, config).unwrap();
+    let (mut procs, mut pool) = process_pool(3, config);
     create(&mut pool, 100, 20);
     let trace = run_program(&mut pool, &mut |step, iteration| {
         // Mid-step: the next evaluation finds worker 0 gone.
@@ -46,9 +44,7 @@ fn killed_workers_are_replaced_with_commit_calls() {
 fn a_killed_worker_during_a_batch_is_replaced() {
     // Slow solves (about 10 ms each) so that the kill lands while the batch is running.
     let reference = reference(1000, 1000);
-    let mut procs: Vec<_> = (0..2).map(|_| WorkerProcess::start(&[], &[])).collect();
-    let addrs: Vec<String> = procs.iter().map(|p| p.addr.to_string()).collect();
-    let mut pool = Pool::connect(&addrs, test_config()).unwrap();
+    let (mut procs, mut pool) = process_pool(2, test_config());
     create(&mut pool, 1000, 1000);
     let mut victim = Some(procs.remove(1));
     let trace = run_program(&mut pool, &mut |step, iteration| {

@@ -10,11 +10,9 @@ use cosdem_pool::{Pool, PoolConfig};
 /// Three worker processes and a pool over them exporting every `k` commits (no rebalancing:
 /// a migration exports fresh states, which would shorten what a failover replays).
 fn pool(k: u64) -> (Vec<WorkerProcess>, Pool) {
-    let procs: Vec<_> = (0..3).map(|_| WorkerProcess::start(&[], &[])).collect();
-    let addrs: Vec<String> = procs.iter().map(|p| p.addr.to_string()).collect();
     let config =
         PoolConfig { export_every: k, rebalance_threshold: f64::INFINITY, ..test_config() };
-    let mut pool = Pool::connect(&addrs, config).unwrap();
+    let (procs, mut pool) = process_pool(3, config);
     create(&mut pool, 100, 20);
     (procs, pool)
 }

@@ -100,7 +100,7 @@ fn pool_commit_twice_is_a_no_op() {
     use cosdem_fem::material::{Material, MaterialInput, TrialId};
     // Export at every commit, so that the stored states show the commit.
     let config = cosdem_pool::PoolConfig { export_every: 1, ..test_config() };
-    let mut pool = cosdem_pool::Pool::in_process(2, config, |_| StandIn::new()).unwrap();
+    let mut pool = standin_pool(2, config);
     create(&mut pool, 10, 1);
     let inputs: Vec<_> = gauss_points()
         .into_iter()

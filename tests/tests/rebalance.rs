@@ -37,8 +37,7 @@ fn a_returning_worker_is_used_from_the_next_step() {
 
 #[test]
 fn placement_follows_disc_counts() {
-    use cosdem_worker::StandIn;
-    let mut pool = Pool::in_process(2, test_config(), |_| StandIn::new()).unwrap();
+    let mut pool = standin_pool(2, test_config());
     // One big assembly and four small ones: the big one gets a worker to itself.
     let big = cosdem_common::GaussPointId::new(0, 0);
     pool.create_assemblies(&[big], &spec(4000, 1)).unwrap();

@@ -1,9 +1,10 @@
 //! Symmetric scenes on a half or quarter mesh (`[mesh] symmetry`, issue 6 item 3d) give the
 //! whole panel's load-displacement curve.
 //!
-//! Elastic panel (4 x 4 elements, confined, rough platens): the full problem is exactly
-//! mirror-symmetric, so the reduced meshes solve the same linear equations restricted to the
-//! kept part; the curves agree to round-off (1e-9 relative: a few hundred dofs, direct solves).
+//! Elastic panel (the `elastic-panel-confined` fixture: 4 x 4 elements, confined, rough
+//! platens): the full problem is exactly mirror-symmetric, so the reduced meshes solve the same
+//! linear equations restricted to the kept part; the curves agree to round-off (1e-9 relative:
+//! a few hundred dofs, direct solves).
 //!
 //! DEM panel (the quick job, 2 x 2 elements, three steps): each assembly answers a mirrored
 //! deformation only up to its own discreteness and relaxation tolerance (1e-4), and each load
@@ -11,53 +12,40 @@
 //! the curves agree to the Newton tolerance, not to round-off: 1e-3 relative is asserted
 //! (measured: 1.6e-7 on the half mesh, 4e-4 on the quarter).
 
-use cosdem_common::GaussPointId;
-use cosdem_common::micro::{AssemblyRequest, BoundaryKind};
-use cosdem_fem::material::ElasticCosserat;
-use cosdem_fem::solve::Solver;
-use cosdem_job::{Job, MaterialSection};
-use cosdem_pool::{Pool, PoolConfig};
-use cosdem_worker::Dem;
+mod common;
 
-const ELASTIC: &str = r#"
-    [mesh]
-    kind = "rectangle"
-    lx = 1.0
-    ly = 2.0
-    nx = 4
-    ny = 4
-    [loading]
-    steps = 3
-    [loading.compression]
-    displacement = 0.01
-    [[loading.pressure]]
-    set = "left"
-    value = 1.0e5
-    [[loading.pressure]]
-    set = "right"
-    value = 1.0e5
-    [material]
-    kind = "elastic"
-    shear_modulus = 2e7
-    poisson = 0.25
-"#;
+use cosdem_app::output::run_dir::RunWriter;
+use cosdem_app::run::{Ending, Run, RunObserver};
+use cosdem_fem::solve::{SolutionView, StepReport};
+use cosdem_fem::symmetry::Symmetry;
+use cosdem_job::fixtures;
+use cosdem_job::{Job, Moving};
 
-fn with_symmetry(text: &str, sym: &str) -> String {
-    text.replacen("kind = \"rectangle\"", &format!("kind = \"rectangle\"\nsymmetry = \"{sym}\""), 1)
+/// `job` on the reduced mesh `symmetry`, validated as a job file would be.
+fn with_symmetry(job: &Job, symmetry: Symmetry) -> Job {
+    let mut job = job.clone();
+    job.mesh.symmetry = symmetry;
+    job.validate().unwrap();
+    job
 }
 
 /// `(displacement, load)` of every step: `load = -scale * R_y(load_set)`.
-fn curve(job: &Job, material: &mut dyn cosdem_fem::material::Material) -> Vec<(f64, f64)> {
-    let mut solver = Solver::new(job.model().unwrap(), job.solver_settings().unwrap()).unwrap();
-    let mut reports = Vec::new();
-    solver.run(material, &mut reports).unwrap();
-    reports
-        .iter()
-        .map(|r| {
-            let ry = r.reactions[&job.loading.load_set][1];
-            (r.load_factor * job.shortening(), -job.load_scale() * ry)
-        })
-        .collect()
+struct Curve<'j> {
+    job: &'j Job,
+    points: Vec<(f64, f64)>,
+}
+
+impl RunObserver for Curve<'_> {
+    fn on_step(
+        &mut self,
+        r: &StepReport,
+        _: &SolutionView<'_>,
+        _: Option<&RunWriter>,
+    ) -> cosdem_fem::Result<()> {
+        let ry = r.reactions[&self.job.loading.load_set][1];
+        self.points.push((r.load_factor * self.job.shortening(), -self.job.load_scale() * ry));
+        Ok(())
+    }
 }
 
 fn compare(a: &[(f64, f64)], b: &[(f64, f64)], tol: f64, what: &str) {
@@ -70,53 +58,55 @@ fn compare(a: &[(f64, f64)], b: &[(f64, f64)], tol: f64, what: &str) {
     }
 }
 
+/// The full elastic panel's load at its last step (1 cm), measured; a direct solve of a few
+/// hundred dofs, so 1e-9 relative covers any change of summation order.
+const ELASTIC_LAST_LOAD: f64 = 300_000.000_000_000_3;
+
 #[test]
 fn elastic_half_and_quarter_meshes_give_the_full_curve() {
-    let run = |text: &str| {
-        let job = Job::from_toml(text, "elastic").unwrap();
-        let mut m = ElasticCosserat::new(2e7, 0.25, 1e7, 0.01);
-        curve(&job, &mut m)
+    // The job's own material: G = 20 MPa, nu = 0.25, Gc = G / 2, lc = 0.01 m.
+    let run = |job: &Job| {
+        let mut curve = Curve { job, points: Vec::new() };
+        let outcome = Run::without_dir(job).observer(&mut curve).execute().unwrap();
+        assert!(matches!(outcome.ending, Ending::Finished), "{:?}", outcome.ending);
+        curve.points
     };
-    let full = run(ELASTIC);
-    assert!(full.last().unwrap().1 > 0.0, "compression positive");
-    compare(&full, &run(&with_symmetry(ELASTIC, "half_x")), 1e-9, "elastic half_x");
-    compare(&full, &run(&with_symmetry(ELASTIC, "quarter")), 1e-9, "elastic quarter");
+    let elastic = fixtures::load("elastic-panel-confined");
+    let full = run(&elastic);
+    let last = full.last().unwrap().1;
+    assert!(
+        (last - ELASTIC_LAST_LOAD).abs() <= 1e-9 * ELASTIC_LAST_LOAD,
+        "compression load {last} N, measured {ELASTIC_LAST_LOAD} N"
+    );
+    compare(&full, &run(&with_symmetry(&elastic, Symmetry::HalfX)), 1e-9, "elastic half_x");
+    compare(&full, &run(&with_symmetry(&elastic, Symmetry::Quarter)), 1e-9, "elastic quarter");
 }
 
 #[test]
 fn reduced_meshes_need_even_counts_and_a_symmetric_compression() {
-    let odd = with_symmetry(ELASTIC, "half_x").replace("nx = 4", "nx = 3");
-    let err = Job::from_toml(&odd, "j").unwrap_err().to_string();
+    let elastic = fixtures::load("elastic-panel-confined");
+    let mut odd = elastic.clone();
+    odd.mesh.symmetry = Symmetry::HalfX;
+    odd.mesh.nx = Some(3);
+    let err = odd.validate().unwrap_err().to_string();
     assert!(err.contains("mesh.nx") && err.contains('3'), "{err}");
-    let top = with_symmetry(ELASTIC, "quarter")
-        .replace("displacement = 0.01", "displacement = 0.01\nmoving = \"top\"");
-    let err = Job::from_toml(&top, "j").unwrap_err().to_string();
+    let mut top = elastic;
+    top.mesh.symmetry = Symmetry::Quarter;
+    top.loading.compression.as_mut().unwrap().moving = Moving::Top;
+    let err = top.validate().unwrap_err().to_string();
     assert!(err.contains("mesh.symmetry"), "{err}");
 }
 
-fn dem_curve(text: &str) -> Vec<(f64, f64)> {
-    let job = Job::from_toml(text, "quick.toml").unwrap();
-    let MaterialSection::Dem { assembly } = &job.material else { panic!("a DEM job") };
-    let solver = Solver::new(job.model().unwrap(), job.solver_settings().unwrap()).unwrap();
-    let per = solver.gauss().per_element as u32;
-    let ids: Vec<GaussPointId> = (0..solver.model().mesh.n_elements() as u32)
-        .flat_map(|e| (0..per).map(move |p| GaussPointId::new(e, p)))
-        .collect();
-    let mut pool = Pool::in_process(1, PoolConfig::default(), |_| Dem).unwrap();
-    let request = AssemblyRequest {
-        spec_json: serde_json::to_vec(assembly).unwrap(),
-        boundary: BoundaryKind::Unspecified,
-        disc_count_hint: 0,
-    };
-    pool.create_assemblies(&ids, &request).unwrap();
-    curve(&job, &mut pool)
+fn dem_curve(job: &Job) -> Vec<(f64, f64)> {
+    let mut curve = Curve { job, points: Vec::new() };
+    common::run_in_process(job, 1, 0, &mut curve);
+    curve.points
 }
 
 #[test]
 fn dem_half_and_quarter_meshes_give_the_full_curve_to_the_newton_tolerance() {
-    let text = include_str!("../../examples/quick.toml")
-        .replace("displacement = 0.02", "displacement = 0.006");
-    let full = dem_curve(&text);
-    compare(&full, &dem_curve(&with_symmetry(&text, "half_x")), 1e-3, "dem half_x");
-    compare(&full, &dem_curve(&with_symmetry(&text, "quarter")), 1e-3, "dem quarter");
+    let quick = common::quick(0.006);
+    let full = dem_curve(&quick);
+    compare(&full, &dem_curve(&with_symmetry(&quick, Symmetry::HalfX)), 1e-3, "dem half_x");
+    compare(&full, &dem_curve(&with_symmetry(&quick, Symmetry::Quarter)), 1e-3, "dem quarter");
 }

@@ -50,7 +50,7 @@ fn pool_with_wrong_token_is_refused_and_with_the_right_one_works() {
 #[test]
 fn in_process_workers_use_the_token_too() {
     let config = PoolConfig { token: Some(Token::new("abc").unwrap()), ..test_config() };
-    let mut pool = Pool::in_process(2, config, |_| StandIn::new()).unwrap();
+    let mut pool = standin_pool(2, config);
     create(&mut pool, 10, 1);
     assert_identical(&reference(10, 1), &run_program(&mut pool, &mut |_, _| {}));
 }

@@ -44,9 +44,17 @@ fn bad_rows_and_columns_are_rejected() {
     csv.write_row(&[1.0, f64::NAN]).unwrap();
     assert!(std::fs::read_to_string(&path).unwrap().ends_with("1,NaN\n"));
 
-    assert!(CsvWriter::create(&dir.join("x.csv"), &[]).is_err());
-    assert!(CsvWriter::create(&dir.join("x.csv"), &["a", "a"]).is_err());
-    assert!(CsvWriter::create(&dir.join("x.csv"), &["a", ""]).is_err());
+    // Bad headers are refused with the file and what is wrong with them.
+    let refused = |columns: &[&str]| match CsvWriter::create(&dir.join("x.csv"), columns) {
+        Ok(_) => panic!("columns {columns:?} were accepted"),
+        Err(e) => e.to_string(),
+    };
+    let e = refused(&[]);
+    assert!(e.contains("x.csv") && e.contains("at least one column"), "{e}");
+    let e = refused(&["a", "a"]);
+    assert!(e.contains("x.csv") && e.contains("column name \"a\" appears twice"), "{e}");
+    let e = refused(&["a", ""]);
+    assert!(e.contains("x.csv") && e.contains("column 1 has an empty name"), "{e}");
     // Names with commas or quotes are quoted.
     CsvWriter::create(&dir.join("q.csv"), &["load, top", "say \"hi\""]).unwrap();
     assert_eq!(

@@ -4,48 +4,28 @@
 //! the stiffness E and the Fig. 5 stiffness E50 must both equal load / displacement (to 1e-9
 //! relative: a least-squares slope of exact multiples, a few roundings).
 
-use cosdem_app::output::run_dir::{RunSettings, RunWriter};
-use cosdem_fem::material::ElasticCosserat;
-use cosdem_fem::solve::Solver;
-use cosdem_job::Job;
-
-const JOB: &str = r#"
-    title = "elastic panel"
-    [mesh]
-    kind = "rectangle"
-    lx = 1.0
-    ly = 1.0
-    nx = 2
-    ny = 2
-    [loading]
-    steps = 4
-    [loading.compression]
-    displacement = 0.008
-    [material]
-    kind = "elastic"
-    shear_modulus = 2e7
-    poisson = 0.25
-"#;
+use cosdem_app::run::{Ending, Run};
+use cosdem_job::{MaterialSection, fixtures};
 
 #[test]
 fn every_step_is_on_disk_with_its_metrics() {
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("run_dir_test");
     let _ = std::fs::remove_dir_all(&dir);
-    let job = Job::from_toml(JOB, "inline").unwrap();
-    let settings = RunSettings {
-        title: job.title.clone(),
-        shortening: job.shortening(),
-        load_set: job.loading.load_set.clone(),
-        load_scale: job.load_scale(),
-        vtk_every: 1,
-        internal_length: 0.01,
-        linear_range: 0.01,
+    // The elastic-panel fixture compressed by 8 mm in 4 steps, with G = 20 MPa, nu = 0.25
+    // (Gc = G / 2, lc = 0.01 m), VTK every step and the paper's linear range (the defaults).
+    let mut job = fixtures::load("elastic-panel");
+    job.title = "elastic panel".into();
+    job.loading.compression.as_mut().unwrap().displacement = 0.008;
+    job.material = MaterialSection::Elastic {
+        shear_modulus: 2e7,
+        poisson: 0.25,
+        cosserat_modulus: None,
+        length: None,
     };
-    let mut writer = RunWriter::create(&dir, settings).unwrap();
-    let mut solver = Solver::new(job.model().unwrap(), job.solver_settings().unwrap()).unwrap();
-    let mut material = ElasticCosserat::new(2e7, 0.25, 1e7, 0.01);
-    solver.run(&mut material, &mut writer).unwrap();
-    writer.finish(Ok(())).unwrap();
+    job.validate().unwrap();
+    assert_eq!((job.output.vtk_every, job.output.linear_range), (1, 0.01));
+    let outcome = Run::new(&job, &dir).execute().unwrap();
+    assert!(matches!(outcome.ending, Ending::Finished), "{:?}", outcome.ending);
 
     let csv = std::fs::read_to_string(dir.join("curve.csv")).unwrap();
     let rows: Vec<&str> = csv.lines().skip(1).collect();
@@ -61,9 +41,9 @@ fn every_step_is_on_disk_with_its_metrics() {
     }
     let summary = std::fs::read_to_string(dir.join("summary.json")).unwrap();
     assert!(summary.contains("\"status\": \"finished\""), "{summary}");
-    let (d, f) = *writer.curve().last().unwrap();
+    let (d, f) = *outcome.curve.last().unwrap();
     assert!((d - 0.008).abs() < 1e-15);
-    let m = &writer.summary().metrics;
+    let m = &outcome.summary.as_ref().unwrap().metrics;
     let secant = f / d;
     assert!((m.stiffness.unwrap() - secant).abs() <= 1e-9 * secant);
     assert!((m.stiffness_50.unwrap() - secant).abs() <= 1e-9 * secant);

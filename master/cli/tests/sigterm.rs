@@ -4,35 +4,30 @@
 
 #![cfg(unix)]
 
+use cosdem_job::{Job, MaterialSection, NewtonSection};
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-const JOB: &str = r#"
-title = "sigterm"
-[mesh]
-kind = "rectangle"
-lx = 1.0
-ly = 1.0
-nx = 2
-ny = 2
-[loading]
-steps = 400
-[loading.compression]
-displacement = 0.02
-[[loading.pressure]]
-set = "left"
-value = 1.0e5
-[[loading.pressure]]
-set = "right"
-value = 1.0e5
-[newton]
-force_tolerance = 1.0e-2
-displacement_tolerance = 1.0e-2
-[material]
-kind = "dem"
-[material.assembly]
-packing = { kind = "hexagonal", radius = 0.005, side = 0.06 }
-"#;
+/// A DEM job long enough to be signalled mid-run: the `dem-one-element` fixture on a 2 x 2
+/// mesh with smaller assemblies (side 0.06 m), 2 cm in 400 steps, Newton tolerances 1e-2 and
+/// the default iteration limit. Written as a job file for the binary.
+fn long_job() -> Job {
+    let mut job = cosdem_job::fixtures::load("dem-one-element");
+    job.title = "sigterm".into();
+    (job.mesh.nx, job.mesh.ny) = (Some(2), Some(2));
+    job.loading.steps = 400;
+    job.loading.compression.as_mut().unwrap().displacement = 0.02;
+    job.newton.force_tolerance = 1.0e-2;
+    job.newton.displacement_tolerance = 1.0e-2;
+    job.newton.max_iterations = NewtonSection::default().max_iterations;
+    let MaterialSection::Dem { assembly } = &mut job.material else { panic!("a DEM job") };
+    let cosdem_dem::PackingSpec::Hexagonal { side, .. } = &mut assembly.packing else {
+        panic!("a hexagonal packing")
+    };
+    *side = 0.06;
+    job.validate().unwrap();
+    job
+}
 
 fn rows(dir: &std::path::Path) -> usize {
     std::fs::read_to_string(dir.join("curve.csv"))
@@ -45,7 +40,9 @@ fn sigterm_stops_after_the_step_and_resume_finishes() {
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     let job = dir.join("job.toml");
-    std::fs::write(&job, JOB).unwrap();
+    let text = toml::to_string(&long_job()).unwrap();
+    assert_eq!(Job::from_toml(&text, "job.toml").unwrap(), long_job(), "the file is the job");
+    std::fs::write(&job, text).unwrap();
     let out = dir.join("run");
     let bin = env!("CARGO_BIN_EXE_cosdem");
     let mut child = Command::new(bin)

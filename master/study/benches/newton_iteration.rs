@@ -2,7 +2,7 @@
 //! numeric Cholesky factorization with a reused symbolic analysis, solve) on Q8 meshes of
 //! the unit panel with the elastic Cosserat material. Prints ms per iteration.
 //!
-//! Run: `cargo bench -p cosdem-master --bench newton_iteration`.
+//! Run: `cargo bench -p cosdem-study --bench newton_iteration`.
 
 use cosdem_fem::solve::IterationTiming;
 use std::time::Instant;

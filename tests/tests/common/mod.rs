@@ -1,15 +1,19 @@
 //! Shared helpers: stand-in specs, a small two-scale-like loading program driven through the
-//! `Material` trait, in-process TCP workers on port 0, and worker processes.
+//! `Material` trait, in-process TCP workers on port 0, worker processes, and the quick example
+//! job run through the run driver on in-process DEM workers.
 #![allow(dead_code, missing_docs)]
 
+use cosdem_app::run::{Ending, Run, RunObserver, RunOutcome, WorkerChoice};
 use cosdem_common::micro::{AssemblyRequest, BoundaryKind};
 use cosdem_common::{GaussPointId, MacroDeformation, MicroResponse};
 use cosdem_fem::material::{Material, MaterialInput, TrialId};
+use cosdem_job::Job;
 use cosdem_pool::{Pool, PoolConfig};
 use cosdem_proto::v1::micro_solver_client::MicroSolverClient;
 use cosdem_worker::{StandIn, WorkerConfig, bind, serve_listener};
 use std::io::{BufRead, BufReader};
 use std::net::SocketAddr;
+use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::time::Duration;
 use tonic::transport::Channel;
@@ -131,9 +135,23 @@ pub fn test_config() -> PoolConfig {
     }
 }
 
+/// A pool of `n` in-process stand-in workers built with `config`.
+pub fn standin_pool(n: usize, config: PoolConfig) -> Pool {
+    Pool::in_process(n, config, |_| StandIn::new()).unwrap()
+}
+
+/// `n` worker processes (the test-worker binary, default arguments) and a pool connected to
+/// them, in that order, with `config`. The processes live as long as the returned vector.
+pub fn process_pool(n: usize, config: PoolConfig) -> (Vec<WorkerProcess>, Pool) {
+    let procs: Vec<_> = (0..n).map(|_| WorkerProcess::start(&[], &[])).collect();
+    let addrs: Vec<String> = procs.iter().map(|p| p.addr.to_string()).collect();
+    let pool = Pool::connect(&addrs, config).unwrap();
+    (procs, pool)
+}
+
 /// The reference run: one in-process worker.
 pub fn reference(discs: u64, work: u64) -> Trace {
-    let mut pool = Pool::in_process(1, test_config(), |_| StandIn::new()).unwrap();
+    let mut pool = standin_pool(1, test_config());
     create(&mut pool, discs, work);
     run_program(&mut pool, &mut |_, _| {})
 }
@@ -192,4 +210,34 @@ impl Drop for WorkerProcess {
     fn drop(&mut self) {
         self.kill();
     }
+}
+
+/// `examples/quick.toml` (a confined 2 x 2 panel, 16 DEM assemblies of 105 discs, 2 mm steps)
+/// compressed by `displacement` (m) only, so that it takes `displacement / 2 mm` steps.
+pub fn quick(displacement: f64) -> Job {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../examples/quick.toml");
+    let mut job = Job::load(&path).unwrap();
+    job.loading.compression.as_mut().expect("quick compresses its panel").displacement =
+        displacement;
+    job
+}
+
+/// Runs `job` through the run driver without a run directory, its DEM assemblies on `workers`
+/// in-process workers of `threads` relaxation threads each (0: the pool's default), telling
+/// `observer` about every step. Panics unless every step converges.
+pub fn run_in_process(
+    job: &Job,
+    workers: usize,
+    threads: usize,
+    observer: &mut dyn RunObserver,
+) -> RunOutcome {
+    let mut job = job.clone();
+    job.workers.in_process = workers;
+    let choice = WorkerChoice {
+        addresses: Vec::new(),
+        config: PoolConfig { in_process_threads: threads, ..PoolConfig::default() },
+    };
+    let outcome = Run::without_dir(&job).workers(choice).observer(observer).execute().unwrap();
+    assert!(matches!(outcome.ending, Ending::Finished), "{:?}", outcome.ending);
+    outcome
 }

@@ -4,40 +4,23 @@
 
 use super::*;
 
-const JOB: &str = r#"
-    [mesh]
-    kind = "rectangle"
-    lx = 1.0
-    ly = 1.0
-    nx = 1
-    ny = 1
-    [loading]
-    steps = 2
-    [loading.compression]
-    displacement = 0.004
-    [[loading.pressure]]
-    set = "left"
-    value = 1.0e5
-    [[loading.pressure]]
-    set = "right"
-    value = 1.0e5
-    [newton]
-    force_tolerance = 5.0e-3
-    displacement_tolerance = 5.0e-3
-    max_iterations = 20
-    [material]
-    kind = "dem"
-    [material.assembly]
-    packing = { kind = "hexagonal", radius = 0.005, side = 0.1 }
-"#;
+/// The `dem-one-element` fixture: one Q8 element of four hexagonal assemblies (5 mm discs),
+/// 100 kPa on both sides, 4 mm in 2 steps.
+fn tiny() -> Job {
+    cosdem_job::fixtures::load("dem-one-element")
+}
 
 fn temp(name: &str) -> PathBuf {
     std::env::temp_dir().join(format!("cosdem-study-{name}-{}", std::process::id()))
 }
 
+/// Peak loads (N) of the three sizes, measured.
+const PEAK_LOADS: [f64; 3] =
+    [201_901.493_276_461_32, 227_970.754_682_257_54, 221_931.095_573_616_94];
+
 #[test]
 fn three_tiny_sizes_run_deterministically_and_write_files() {
-    let job = Job::from_toml(JOB, "tiny").unwrap();
+    let job = tiny();
     let sizes = vec![0.0016, 0.0025, 0.0036];
     let one = RveSizeSettings { sizes: sizes.clone(), threads: 1, ..Default::default() };
     let two = RveSizeSettings { threads: 2, ..one.clone() };
@@ -51,7 +34,17 @@ fn three_tiny_sizes_run_deterministically_and_write_files() {
         // Bit-identical whatever the number of runs side by side.
         assert_eq!(x.metrics, y.metrics);
         assert_eq!(x.dem_steps, y.dem_steps);
-        assert!(x.metrics.peak_load > 0.0);
+    }
+    // The peak loads, measured (N): deterministic runs, so 1e-9 relative covers only a change
+    // of summation order.
+    for (run, want) in a.runs.iter().zip(PEAK_LOADS) {
+        let rel = (run.metrics.peak_load - want).abs() / want;
+        assert!(
+            rel <= 1e-9,
+            "size {}: peak load {} N, measured {want} N",
+            run.size,
+            run.metrics.peak_load
+        );
     }
     assert!(a.runs[0].discs < a.runs[1].discs && a.runs[1].discs < a.runs[2].discs);
     for f in [
@@ -92,19 +85,20 @@ fn three_tiny_sizes_run_deterministically_and_write_files() {
 
 #[test]
 fn bad_sizes_and_materials_are_errors_naming_the_value() {
-    let job = Job::from_toml(JOB, "tiny").unwrap();
+    let job = tiny();
     let e = job_for_size(&job, -1.0, None).unwrap_err().to_string();
     assert!(e.contains("sizes") && e.contains("-1"), "{e}");
     // side = 0.03 < 8 r = 0.04: the packing's own check names the key.
     let e = job_for_size(&job, 0.0009, None).unwrap_err().to_string();
     assert!(e.contains("packing.side"), "{e}");
-    let elastic =
-        JOB.replace("kind = \"dem\"", "kind = \"elastic\"\nshear_modulus = 1e7\npoisson = 0.3");
-    let elastic = elastic.replace(
-        "[material.assembly]\n    packing = { kind = \"hexagonal\", radius = 0.005, side = 0.1 }",
-        "",
-    );
-    let job = Job::from_toml(&elastic, "e").unwrap();
+    let mut job = tiny();
+    job.material = cosdem_job::MaterialSection::Elastic {
+        shear_modulus: 1e7,
+        poisson: 0.3,
+        cosserat_modulus: None,
+        length: None,
+    };
+    job.validate().unwrap();
     assert!(job_for_size(&job, 0.01, None).unwrap_err().to_string().contains("dem"));
 }
 
@@ -115,12 +109,14 @@ fn bad_sizes_and_materials_are_errors_naming_the_value() {
 /// without the load scale they would differ by a factor 2.
 #[test]
 fn symmetric_meshes_report_the_whole_panel_load() {
-    let full = JOB.replace("nx = 1", "nx = 2");
-    let half = full.replace("nx = 2", "nx = 2\n    symmetry = \"half_x\"");
+    let mut full = tiny();
+    full.mesh.nx = Some(2);
+    let mut half = full.clone();
+    half.mesh.symmetry = cosdem_fem::symmetry::Symmetry::HalfX;
     let settings = RveSizeSettings { sizes: vec![0.0025], threads: 1, ..Default::default() };
-    let run = |toml: &str| {
-        let job = Job::from_toml(toml, "sym").unwrap();
-        run_size(&job, 0.0025, &settings, None).unwrap()
+    let run = |job: &Job| {
+        job.validate().unwrap();
+        run_size(job, 0.0025, &settings, None).unwrap()
     };
     let (f, h) = (run(&full), run(&half));
     assert_eq!(f.status, "finished");

@@ -222,7 +222,8 @@ mod tests {
         let img = image::open(&p).unwrap().to_rgb8();
         assert!(img.pixels().filter(|q| q.0 == [20, 60, 150]).count() > 500);
         let empty = ParticleSnapshot::default();
-        assert!(plot_force_chains(&empty, "", &dir.join("e.png")).is_err());
+        let e = plot_force_chains(&empty, "", &dir.join("e.png")).unwrap_err();
+        assert!(matches!(&e, PlotError::NoData { message, .. } if message == "no discs"), "{e}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }
