@@ -7,38 +7,11 @@
 
 mod common;
 
-use cosdem_app::output::run_dir::RunWriter;
-use cosdem_app::run::RunObserver;
-use cosdem_fem::solve::{SolutionView, StepReport};
+use common::StepBits;
 
-#[derive(Default)]
-struct Record {
-    reactions: Vec<u64>,
-    stresses: Vec<u64>,
-    steps: u64,
-}
-
-impl RunObserver for Record {
-    fn on_step(
-        &mut self,
-        r: &StepReport,
-        s: &SolutionView<'_>,
-        _: Option<&RunWriter>,
-    ) -> cosdem_fem::Result<()> {
-        for v in r.reactions.values() {
-            self.reactions.extend(v.iter().map(|x| x.to_bits()));
-        }
-        for g in s.gauss_points {
-            self.stresses.extend(g.stress.iter().map(|x| x.to_bits()));
-            self.steps += g.diagnostics.steps;
-        }
-        Ok(())
-    }
-}
-
-fn run(workers: usize, threads: usize) -> Record {
+fn run(workers: usize, threads: usize) -> StepBits {
     let job = common::quick(0.006);
-    let mut record = Record::default();
+    let mut record = StepBits::default();
     let outcome = common::run_in_process(&job, workers, threads, &mut record);
     assert_eq!(outcome.steps, 3, "the job must reach its end");
     record

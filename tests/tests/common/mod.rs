@@ -3,10 +3,12 @@
 //! job run through the run driver on in-process DEM workers.
 #![allow(dead_code, missing_docs)]
 
+use cosdem_app::output::run_dir::RunWriter;
 use cosdem_app::run::{Ending, Run, RunObserver, RunOutcome, WorkerChoice};
 use cosdem_common::micro::{AssemblyRequest, BoundaryKind};
-use cosdem_common::{GaussPointId, MacroDeformation, MicroResponse};
+use cosdem_common::{Answer, GaussPointId, MacroDeformation, MicroResponse};
 use cosdem_fem::material::{Material, MaterialInput, TrialId};
+use cosdem_fem::solve::{SolutionView, StepReport};
 use cosdem_job::Job;
 use cosdem_pool::{Pool, PoolConfig};
 use cosdem_proto::v1::micro_solver_client::MicroSolverClient;
@@ -240,4 +242,38 @@ pub fn run_in_process(
     let outcome = Run::without_dir(&job).workers(choice).observer(observer).execute().unwrap();
     assert!(matches!(outcome.ending, Ending::Finished), "{:?}", outcome.ending);
     outcome
+}
+
+/// What every step of a run computed, to the bit: the reactions and the Gauss-point stresses
+/// (as `f64::to_bits`), the answer kind of every Gauss point and the DEM steps its answer
+/// took, in step order. For comparing runs exactly (determinism is the contract).
+#[derive(Default, PartialEq, Debug)]
+pub struct StepBits {
+    /// The reactions of every step.
+    pub reactions: Vec<u64>,
+    /// The stresses of every Gauss point of every step.
+    pub stresses: Vec<u64>,
+    /// How every Gauss point of every step was answered.
+    pub answers: Vec<Answer>,
+    /// The DEM steps of all the answers.
+    pub steps: u64,
+}
+
+impl RunObserver for StepBits {
+    fn on_step(
+        &mut self,
+        r: &StepReport,
+        s: &SolutionView<'_>,
+        _: Option<&RunWriter>,
+    ) -> cosdem_fem::Result<()> {
+        for v in r.reactions.values() {
+            self.reactions.extend(v.iter().map(|x| x.to_bits()));
+        }
+        for g in s.gauss_points {
+            self.stresses.extend(g.stress.iter().map(|x| x.to_bits()));
+            self.answers.push(g.diagnostics.answer);
+            self.steps += g.diagnostics.steps;
+        }
+        Ok(())
+    }
 }

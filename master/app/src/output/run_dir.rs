@@ -140,19 +140,7 @@ impl RunWriter {
             status: "running".into(),
             ..Summary::default()
         };
-        let mut w = Self {
-            dir: dir.to_path_buf(),
-            settings,
-            csv,
-            fields,
-            gauss,
-            curve: Vec::new(),
-            summary,
-            started: Instant::now(),
-            visuals: VisualOutputs::default(),
-        };
-        w.write_summary()?;
-        Ok(w)
+        Self::open(dir, settings, csv, (fields, gauss), Vec::new(), summary, Instant::now())
     }
 
     /// Continues the run directory of a run resumed at committed step `step` (from its
@@ -239,6 +227,21 @@ impl RunWriter {
         let started = Instant::now()
             .checked_sub(std::time::Duration::from_secs_f64(before.max(0.0)))
             .unwrap_or_else(Instant::now);
+        Self::open(dir, settings, csv, (fields, gauss), curve, summary, started)
+    }
+
+    /// The writer of the run directory `dir` with its open `curve.csv`, its `.pvd` series
+    /// `(fields, gauss)` (if VTK is written), the `curve` and `summary` so far and the time
+    /// the run `started`; writes the summary.
+    fn open(
+        dir: &Path,
+        settings: RunSettings,
+        csv: CsvWriter,
+        (fields, gauss): (Option<PvdWriter>, Option<PvdWriter>),
+        curve: Vec<(f64, f64)>,
+        summary: Summary,
+        started: Instant,
+    ) -> Result<Self> {
         let mut w = Self {
             dir: dir.to_path_buf(),
             settings,

@@ -3,8 +3,10 @@
 //! fitted size law (Figs. 4-5).
 
 use crate::rve_size::fit::SizeLawFit;
+use cosdem_app::output::plot::curve::LoadScales;
 use cosdem_app::output::plot::{
-    DrawResult, FONT, PlotError, Result, SIZE, register_font, si_prefix, sig4, viridis,
+    DrawResult, LineAxes, PlotError, Result, blank_figure, draw_legend, register_font, si_prefix,
+    sig4, viridis,
 };
 use plotters::prelude::*;
 use std::path::Path;
@@ -21,32 +23,13 @@ pub fn plot_study_curves(
     if all().next().is_none() {
         return Err(PlotError::NoData { path: path.to_path_buf(), message: "no curve".into() });
     }
-    let dmax = all().map(|p| p.0).fold(0.0, f64::max).max(1e-12);
-    let fmax = all().map(|p| p.1).fold(0.0, f64::max);
-    let fmin = all().map(|p| p.1).fold(0.0, f64::min);
-    let (div, prefix) = si_prefix(fmax.abs().max(fmin.abs()));
-    let (dd, dprefix) = if dmax < 0.1 { (1e-3, "m") } else { (1.0, "") };
+    let scales = LoadScales::of(all().copied());
+    let LoadScales { fmax, fmin, div, dd, .. } = scales;
     let y1 = if fmax > 0.0 { fmax / div * 1.08 } else { 1.0 };
     let y0 = (fmin / div).min(0.0) * 1.08;
-    let root = BitMapBackend::new(path, SIZE).into_drawing_area();
-    root.fill(&WHITE).at(path)?;
-    let mut chart = ChartBuilder::on(&root)
-        .margin(20)
-        .caption(format!("Load-displacement per assembly size: {title}"), (FONT, 22))
-        .x_label_area_size(60)
-        .y_label_area_size(90)
-        .build_cartesian_2d(0.0..dmax / dd * 1.04, y0..y1)
-        .at(path)?;
-    chart
-        .configure_mesh()
-        .x_desc(format!("Displacement d ({dprefix}m)"))
-        .y_desc(format!("Load F ({prefix}N/m)"))
-        .label_style((FONT, 18))
-        .axis_desc_style((FONT, 20))
-        .light_line_style(WHITE.mix(0.0))
-        .bold_line_style(BLACK.mix(0.1))
-        .draw()
-        .at(path)?;
+    let root = blank_figure(path)?;
+    let caption = format!("Load-displacement per assembly size: {title}");
+    let mut chart = scales.axes(caption, 22, y0..y1).draw(&root, path)?;
     let n = curves.len().max(2) - 1;
     for (i, (v, c)) in curves.iter().enumerate() {
         // Light yellow is unreadable on white: stop the map at 0.85.
@@ -63,14 +46,7 @@ pub fn plot_study_curves(
                 PathElement::new(vec![(x, y), (x + 24, y)], colour.stroke_width(3))
             });
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .label_font((FONT, 18))
-        .background_style(WHITE.mix(0.9))
-        .border_style(BLACK.mix(0.5))
-        .draw()
-        .at(path)?;
+    draw_legend(&mut chart, SeriesLabelPosition::UpperRight, 18, path)?;
     root.present().at(path)?;
     Ok(())
 }
@@ -101,25 +77,17 @@ pub fn plot_size_law(
     let (div, prefix) = si_prefix(hi.abs().max(lo.abs()));
     let pad = 0.1 * (hi - lo).abs().max(0.05 * hi.abs()).max(f64::MIN_POSITIVE);
     let (y0, y1) = ((lo - pad) / div, (hi + pad) / div);
-    let root = BitMapBackend::new(path, SIZE).into_drawing_area();
-    root.fill(&WHITE).at(path)?;
-    let mut chart = ChartBuilder::on(&root)
-        .margin(20)
-        .caption(format!("{name} against the assembly size"), (FONT, 24))
-        .x_label_area_size(60)
-        .y_label_area_size(100)
-        .build_cartesian_2d(0.0..vmax * 1.08, y0..y1)
-        .at(path)?;
-    chart
-        .configure_mesh()
-        .x_desc("Assembly size V (m^2)")
-        .y_desc(format!("{name} ({prefix}{unit})"))
-        .label_style((FONT, 18))
-        .axis_desc_style((FONT, 20))
-        .light_line_style(WHITE.mix(0.0))
-        .bold_line_style(BLACK.mix(0.1))
-        .draw()
-        .at(path)?;
+    let root = blank_figure(path)?;
+    let axes = LineAxes {
+        caption: format!("{name} against the assembly size"),
+        caption_size: 24,
+        y_label_area: 100,
+        x: 0.0..vmax * 1.08,
+        y: y0..y1,
+        x_desc: "Assembly size V (m^2)".into(),
+        y_desc: format!("{name} ({prefix}{unit})"),
+    };
+    let mut chart = axes.draw(&root, path)?;
     let blue = RGBColor(31, 88, 160);
     chart
         .draw_series(points.iter().map(|&(v, f)| Circle::new((v, f / div), 6, blue.filled())))
@@ -188,18 +156,9 @@ pub fn plot_size_law(
         (Some(first), Some(last)) => first.1 > last.1,
         _ => false,
     };
-    chart
-        .configure_series_labels()
-        .position(if falls {
-            SeriesLabelPosition::UpperRight
-        } else {
-            SeriesLabelPosition::LowerRight
-        })
-        .label_font((FONT, 17))
-        .background_style(WHITE.mix(0.9))
-        .border_style(BLACK.mix(0.5))
-        .draw()
-        .at(path)?;
+    let position =
+        if falls { SeriesLabelPosition::UpperRight } else { SeriesLabelPosition::LowerRight };
+    draw_legend(&mut chart, position, 17, path)?;
     root.present().at(path)?;
     Ok(())
 }

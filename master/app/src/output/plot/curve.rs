@@ -1,4 +1,7 @@
-use super::{DrawResult, FONT, PlotError, Result, SIZE, register_font, si_prefix, sig4};
+use super::{
+    DrawResult, LineAxes, PlotError, Result, blank_figure, draw_legend, register_font, si_prefix,
+    sig4,
+};
 use crate::output::io_err;
 use cosdem_fem::post::CurveMetrics;
 use plotters::prelude::*;
@@ -30,6 +33,52 @@ pub fn read_curve(path: &Path) -> Result<Vec<(f64, f64)>> {
     Ok(curve)
 }
 
+/// The scales of a load-displacement chart: the extremes of its points and the units its axes
+/// show them in.
+#[derive(Debug, Clone, Copy)]
+pub struct LoadScales {
+    /// The largest displacement (at least 1e-12).
+    pub dmax: f64,
+    /// The largest load (at least 0).
+    pub fmax: f64,
+    /// The smallest load (at most 0).
+    pub fmin: f64,
+    /// The divisor of the loads on the axis ([`si_prefix`] of the largest magnitude).
+    pub div: f64,
+    /// The SI prefix of [`Self::div`].
+    pub prefix: &'static str,
+    /// The divisor of the displacements on the axis: millimetres below 0.1 m, else metres.
+    pub dd: f64,
+    /// The SI prefix of [`Self::dd`].
+    pub dprefix: &'static str,
+}
+
+impl LoadScales {
+    /// The scales of the `(displacement, load)` points.
+    pub fn of(points: impl Iterator<Item = (f64, f64)> + Clone) -> Self {
+        let dmax = points.clone().map(|p| p.0).fold(0.0, f64::max).max(1e-12);
+        let fmax = points.clone().map(|p| p.1).fold(0.0, f64::max);
+        let fmin = points.map(|p| p.1).fold(0.0, f64::min);
+        let (div, prefix) = si_prefix(fmax.abs().max(fmin.abs()));
+        let (dd, dprefix) = if dmax < 0.1 { (1e-3, "m") } else { (1.0, "") };
+        Self { dmax, fmax, fmin, div, prefix, dd, dprefix }
+    }
+
+    /// Load-displacement axes with `caption` (of `caption_size`) and the load range `y`
+    /// (already divided by [`Self::div`]): displacement from 0 to 4 % past the largest.
+    pub fn axes(&self, caption: String, caption_size: u32, y: std::ops::Range<f64>) -> LineAxes {
+        LineAxes {
+            caption,
+            caption_size,
+            y_label_area: 90,
+            x: 0.0..self.dmax / self.dd * 1.04,
+            y,
+            x_desc: format!("Displacement d ({}m)", self.dprefix),
+            y_desc: format!("Load F ({}N/m)", self.prefix),
+        }
+    }
+}
+
 /// Fig. 3: load against displacement from the origin through every converged step, with the
 /// bearing capacity F_u (peak), the residual capacity F_res (minimum after the peak) and the
 /// stiffness E (the secant line through the origin) marked. Loads are per metre of thickness.
@@ -45,39 +94,19 @@ pub fn plot_curve(
     }
     let points: Vec<(f64, f64)> =
         std::iter::once((0.0, 0.0)).chain(curve.iter().copied()).collect();
-    let dmax = points.iter().map(|p| p.0).fold(0.0, f64::max).max(1e-12);
-    let fmax = points.iter().map(|p| p.1).fold(0.0, f64::max);
-    let fmin = points.iter().map(|p| p.1).fold(0.0, f64::min);
-    let (div, prefix) = si_prefix(fmax.abs().max(fmin.abs()));
-    let (dd, dprefix) = if dmax < 0.1 { (1e-3, "m") } else { (1.0, "") };
+    let scales = LoadScales::of(points.iter().copied());
+    let LoadScales { dmax, fmax, fmin, div, prefix, dd, dprefix } = scales;
     let y1 = (fmax / div) * 1.12;
     let y1 = if y1 > 0.0 { y1 } else { 1.0 };
     let y0 = (fmin / div).min(0.0) * 1.12;
 
-    let root = BitMapBackend::new(path, SIZE).into_drawing_area();
-    root.fill(&WHITE).at(path)?;
+    let root = blank_figure(path)?;
     let heading = if title.is_empty() {
         "Load-displacement curve".to_string()
     } else {
         format!("Load-displacement curve: {title}")
     };
-    let mut chart = ChartBuilder::on(&root)
-        .margin(20)
-        .caption(heading, (FONT, 24))
-        .x_label_area_size(60)
-        .y_label_area_size(90)
-        .build_cartesian_2d(0.0..dmax / dd * 1.04, y0..y1)
-        .at(path)?;
-    chart
-        .configure_mesh()
-        .x_desc(format!("Displacement d ({dprefix}m)"))
-        .y_desc(format!("Load F ({prefix}N/m)"))
-        .label_style((FONT, 18))
-        .axis_desc_style((FONT, 20))
-        .light_line_style(WHITE.mix(0.0))
-        .bold_line_style(BLACK.mix(0.1))
-        .draw()
-        .at(path)?;
+    let mut chart = scales.axes(heading, 24, y0..y1).draw(&root, path)?;
 
     let scaled = |(d, f): (f64, f64)| (d / dd, f / div);
     let blue = RGBColor(31, 88, 160);
@@ -146,14 +175,7 @@ pub fn plot_curve(
                 PathElement::new(vec![(x, y), (x + 24, y)], orange.stroke_width(2))
             });
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::LowerRight)
-        .label_font((FONT, 18))
-        .background_style(WHITE.mix(0.9))
-        .border_style(BLACK.mix(0.5))
-        .draw()
-        .at(path)?;
+    draw_legend(&mut chart, SeriesLabelPosition::LowerRight, 18, path)?;
     root.present().at(path)?;
     Ok(())
 }
@@ -161,6 +183,7 @@ pub fn plot_curve(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::output::plot::SIZE;
 
     /// A known softening curve is drawn at the figure size with many non-white pixels, and
     /// the blue of the curve is among them.

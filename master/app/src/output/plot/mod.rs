@@ -14,6 +14,10 @@
 //! Each figure is a pure function of its input data ([`curve::plot_curve`],
 //! [`field::plot_strain_field`], [`particles::plot_force_chains`],
 //! [`particles::plot_fluctuations`]); [`plot_run`] finds the inputs in a run directory.
+//! The line figures (here and in the RVE-size study's) share their page
+//! ([`blank_figure`](crate::output::plot::blank_figure)), axes
+//! ([`LineAxes`](crate::output::plot::LineAxes)) and legend box
+//! ([`draw_legend`](crate::output::plot::draw_legend)).
 //! Drawing uses plotters' bitmap backend with a font embedded in the crate (a subset of
 //! DejaVu Sans, `assets/fonts`), so no system font library is needed.
 
@@ -29,6 +33,9 @@ use super::field_data::FieldData;
 use super::pvd::read_pvd;
 use super::snapshots::read_snapshot;
 use cosdem_fem::post::CurveMetrics;
+use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
+use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
 /// Why a figure could not be drawn. Every variant names the file.
@@ -93,6 +100,84 @@ impl<T, E: std::fmt::Display> DrawResult<T> for std::result::Result<T, E> {
 
 /// Figure size in pixels.
 pub const SIZE: (u32, u32) = (1000, 750);
+
+/// A whole figure: the bitmap written to its path.
+pub type Figure<'b> = DrawingArea<BitMapBackend<'b>, Shift>;
+
+/// A chart with `f64` coordinates on both axes, drawn on a [`Figure`].
+pub type XyChart<'a, 'b> =
+    ChartContext<'a, BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// A white figure of [`SIZE`] pixels, to be written to `path` when presented.
+pub fn blank_figure(path: &Path) -> Result<Figure<'_>> {
+    let root = BitMapBackend::new(path, SIZE).into_drawing_area();
+    root.fill(&WHITE).at(path)?;
+    Ok(root)
+}
+
+/// The axes of a line figure (load-displacement curves, a property against a size): a
+/// caption, linear `x` and `y` ranges with their descriptions, and a light mesh of the
+/// major ticks only.
+#[derive(Debug, Clone)]
+pub struct LineAxes {
+    /// The caption above the chart.
+    pub caption: String,
+    /// The caption's font size.
+    pub caption_size: u32,
+    /// The width in pixels of the y labels' area (wide enough for the longest tick label).
+    pub y_label_area: u32,
+    /// The x range.
+    pub x: std::ops::Range<f64>,
+    /// The y range.
+    pub y: std::ops::Range<f64>,
+    /// The x axis' description (quantity and unit).
+    pub x_desc: String,
+    /// The y axis' description (quantity and unit).
+    pub y_desc: String,
+}
+
+impl LineAxes {
+    /// Draws the caption, the axes and the mesh on `root` (drawn to `path`); returns the chart
+    /// to draw the series on.
+    pub fn draw<'a, 'b>(&self, root: &'a Figure<'b>, path: &Path) -> Result<XyChart<'a, 'b>> {
+        let mut chart = ChartBuilder::on(root)
+            .margin(20)
+            .caption(&self.caption, (FONT, self.caption_size))
+            .x_label_area_size(60)
+            .y_label_area_size(self.y_label_area)
+            .build_cartesian_2d(self.x.clone(), self.y.clone())
+            .at(path)?;
+        chart
+            .configure_mesh()
+            .x_desc(&self.x_desc)
+            .y_desc(&self.y_desc)
+            .label_style((FONT, 18))
+            .axis_desc_style((FONT, 20))
+            .light_line_style(WHITE.mix(0.0))
+            .bold_line_style(BLACK.mix(0.1))
+            .draw()
+            .at(path)?;
+        Ok(chart)
+    }
+}
+
+/// Draws the legend of `chart` (drawn to `path`) at `position` with labels of `font_size`,
+/// in a box of translucent white with a grey border.
+pub fn draw_legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+    font_size: u32,
+    path: &Path,
+) -> Result<()> {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .label_font((FONT, font_size))
+        .background_style(WHITE.mix(0.9))
+        .border_style(BLACK.mix(0.5))
+        .draw()
+        .at(path)
+}
 
 /// What [`plot_run`] did: the figures written and the ones that failed (with why).
 #[derive(Debug, Default)]
