@@ -80,6 +80,19 @@ pub(crate) fn invalid(path: &Path, message: String) -> OutputError {
     OutputError::InvalidData { path: path.to_path_buf(), message }
 }
 
+/// The text of an XML attribute value written with [`vtk::escape`]: the entities it writes
+/// turned back into characters (`&amp;` last, so an escaped entity stays literal).
+pub(crate) fn unescape(text: &str) -> String {
+    text.replace("&quot;", "\"")
+        .replace("&apos;", "'")
+        .replace("&lt;", "<")
+        .replace("&gt;", ">")
+        .replace("&#10;", "\n")
+        .replace("&#13;", "\r")
+        .replace("&#9;", "\t")
+        .replace("&amp;", "&")
+}
+
 /// An I/O error on `path`, named in the error.
 pub fn io_err(path: &Path, action: &'static str) -> impl FnOnce(std::io::Error) -> OutputError {
     let path = path.to_path_buf();

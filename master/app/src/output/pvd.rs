@@ -9,7 +9,7 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use super::vtk::escape;
-use super::{Result, invalid, io_err, push_f64, write_atomic};
+use super::{Result, invalid, io_err, push_f64, unescape, write_atomic};
 
 /// One entry of the collection.
 #[derive(Clone, Debug, PartialEq)]
@@ -172,15 +172,4 @@ fn attribute(tag: &str, name: &str) -> Option<String> {
     let start = tag.find(&key)? + key.len();
     let end = start + tag[start..].find('"')?;
     Some(unescape(&tag[start..end]))
-}
-
-fn unescape(text: &str) -> String {
-    text.replace("&quot;", "\"")
-        .replace("&apos;", "'")
-        .replace("&lt;", "<")
-        .replace("&gt;", ">")
-        .replace("&#10;", "\n")
-        .replace("&#13;", "\r")
-        .replace("&#9;", "\t")
-        .replace("&amp;", "&")
 }

@@ -4,7 +4,7 @@
 //! VTK reader.
 
 use super::vtk::{Cell, CellType, DataArray, VtuPiece};
-use super::{Result, invalid, io_err};
+use super::{Result, invalid, io_err, unescape};
 use std::path::Path;
 
 /// Reads a `.vtu` written by [`super::write_vtu`] or [`super::write_vtu_encoded`].
@@ -148,17 +148,6 @@ pub(crate) fn attribute(tag: &str, name: &str) -> Option<String> {
     let start = tag.find(&key)? + key.len();
     let len = tag[start..].find('"')?;
     Some(unescape(&tag[start..start + len]))
-}
-
-fn unescape(s: &str) -> String {
-    s.replace("&lt;", "<")
-        .replace("&gt;", ">")
-        .replace("&quot;", "\"")
-        .replace("&apos;", "'")
-        .replace("&#10;", "\n")
-        .replace("&#13;", "\r")
-        .replace("&#9;", "\t")
-        .replace("&amp;", "&")
 }
 
 /// The numbers of one array as `f64` (integers are exact up to 2^53).
