@@ -138,8 +138,22 @@ impl Job {
 
     /// The FE model: mesh, field, rule, loading.
     pub fn model(&self) -> Result<cosdem_fem::solve::Model> {
+        let mesh = self.build_mesh()?;
+        // The curve's load is the reaction of this set: a name the mesh lacks would report a
+        // load of -0 at every step.
+        let load_set = &self.loading.load_set;
+        if !mesh.node_sets.contains_key(load_set) {
+            return Err(Error::InvalidSetting {
+                field: "loading.load_set",
+                value: load_set.clone(),
+                reason: format!(
+                    "the mesh has no node set of that name (known: {})",
+                    mesh.node_sets.keys().cloned().collect::<Vec<_>>().join(", ")
+                ),
+            });
+        }
         Ok(cosdem_fem::solve::Model {
-            mesh: self.build_mesh()?,
+            mesh,
             field: self.field(),
             rule: self.rule(),
             loading: self.loading(),
@@ -190,6 +204,23 @@ mod tests {
         let model = job.model().unwrap();
         assert_eq!(model.mesh.n_elements(), 4);
         assert_eq!(job.solver_settings().unwrap().steps, 4);
+    }
+
+    /// The curve's load is the reaction of `load_set`: a name the mesh lacks is refused naming
+    /// the key, the value and the sets the mesh has (it used to report a load of -0).
+    #[test]
+    fn an_unknown_load_set_is_refused_naming_the_key() {
+        let mut job = minimal();
+        job.loading.load_set = "nosuch".into();
+        let e = job.model().unwrap_err();
+        assert!(
+            matches!(&e, cosdem_fem::Error::InvalidSetting { field: "loading.load_set", value, .. }
+                if value == "nosuch"),
+            "{e}"
+        );
+        assert!(e.to_string().contains("known: ") && e.to_string().contains("top"), "{e}");
+        job.loading.load_set = "bottom".into();
+        job.model().unwrap();
     }
 
     #[test]
