@@ -230,6 +230,12 @@ impl RunWriter {
         Self::open(dir, settings, csv, (fields, gauss), curve, summary, started)
     }
 
+    /// Counts `setup` (the time spent before the writer was opened: building the solver and
+    /// the workers' assemblies) in the run's wall time, as when the writer was opened first.
+    pub fn add_setup_time(&mut self, setup: std::time::Duration) {
+        self.started = self.started.checked_sub(setup).unwrap_or(self.started);
+    }
+
     /// The writer of the run directory `dir` with its open `curve.csv`, its `.pvd` series
     /// `(fields, gauss)` (if VTK is written), the `curve` and `summary` so far and the time
     /// the run `started`; writes the summary.

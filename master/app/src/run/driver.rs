@@ -228,11 +228,10 @@ impl<'a> Run<'a> {
             }
             _ => None,
         };
-        let mut writer = match (dir, &checkpoint) {
-            (Some(dir), Some(c)) => Some(RunWriter::resume(dir, run_settings(job), c.solver.step)?),
-            (Some(dir), None) => Some(RunWriter::create(dir, run_settings(job))?),
-            (None, _) => None,
-        };
+        // Everything that can fail before the first step (the model, the snapshot ids, the
+        // workers and their assemblies) comes before the writer opens the run directory: a
+        // failed setup leaves a previous run's files as they were.
+        let setup = std::time::Instant::now();
         let mut solver = Solver::new(job.model()?, job.solver_settings()?)?;
         let ids = gauss_point_ids(&solver);
         let watched = if snapshots {
@@ -255,6 +254,14 @@ impl<'a> Run<'a> {
                 (m, 0)
             }
         };
+        let mut writer = match (dir, &checkpoint) {
+            (Some(dir), Some(c)) => Some(RunWriter::resume(dir, run_settings(job), c.solver.step)?),
+            (Some(dir), None) => Some(RunWriter::create(dir, run_settings(job))?),
+            (None, _) => None,
+        };
+        if let Some(w) = writer.as_mut() {
+            w.add_setup_time(setup.elapsed());
+        }
         if let Some(c) = checkpoint {
             solver.restore(c.solver)?;
         }
