@@ -227,7 +227,7 @@ fn a_failed_setup_leaves_the_previous_run_as_it_was() {
     let before: Vec<Vec<u8>> = files.iter().map(|f| std::fs::read(dir.join(f)).unwrap()).collect();
     let mut bad = job.clone();
     bad.loading.load_set = "nosuch".into();
-    let err = Run::new(&bad, &dir).execute().err().expect("an unknown load set is refused");
+    let err = Run::new(&bad, &dir).execute().expect_err("an unknown load set is refused");
     assert!(err.to_string().contains("loading.load_set"), "{err}");
     for (f, b) in files.iter().zip(&before) {
         assert_eq!(&std::fs::read(dir.join(f)).unwrap(), b, "{f} changed by a failed setup");
