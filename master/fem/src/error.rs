@@ -30,7 +30,7 @@ pub enum Error {
         known: String,
     },
     /// An element maps to a non-positive area at a quadrature point.
-    #[error("element {element}: Jacobian determinant {det_j} <= 0 at reference point {xi:?}")]
+    #[error("element {element}: Jacobian determinant {det_j:?} <= 0 at reference point {xi:?}")]
     InvertedElement {
         /// Element index.
         element: usize,
@@ -43,6 +43,15 @@ pub enum Error {
     #[error("job file {file}: {message}")]
     JobFile {
         /// The file (or the origin given to the parser).
+        file: String,
+        /// What went wrong.
+        message: String,
+    },
+    /// A checkpoint cannot be read, written or used (the message says why: checksum,
+    /// format, another job).
+    #[error("checkpoint {file}: {message}")]
+    Checkpoint {
+        /// The checkpoint file.
         file: String,
         /// What went wrong.
         message: String,

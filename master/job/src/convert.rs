@@ -73,11 +73,15 @@ impl Job {
             }
             MeshKind::Gmsh => {
                 let file = m.file.as_deref().unwrap_or(Path::new(""));
-                let raw = gmsh::read_msh(file).map_err(|e| Error::JobFile {
-                    file: file.display().to_string(),
-                    message: e.to_string(),
-                })?;
-                Mesh::from_description(MeshDescription::from(raw))
+                // The reader's and the mesh's errors name the file and the line; the key is
+                // `mesh.file`.
+                let bad = |reason: String| Error::InvalidSetting {
+                    field: "mesh.file",
+                    value: format!("{:?}", file.display().to_string()),
+                    reason,
+                };
+                let raw = gmsh::read_msh(file).map_err(|e| bad(e.to_string()))?;
+                Mesh::from_description(MeshDescription::from(raw)).map_err(|e| bad(e.to_string()))
             }
         }
     }

@@ -8,21 +8,31 @@
 //! TOML.
 //!
 //! - `schema`: the tables as serde structs ([`Job`], [`MeshSection`], [`MaterialSection`], ...);
-//! - `load`: reading TOML text or a file ([`Job::from_toml`], [`Job::load`]);
+//! - `arrays`: the fixed-length arrays (`mesh.origin`, `output.snapshots`), length checked;
+//! - `material`: reading `[material]` as a plain struct, so errors keep their TOML position;
+//! - `load`: reading TOML text or a regular file of at most [`MAX_JOB_FILE_BYTES`]
+//!   ([`Job::from_toml`], [`Job::load`]);
 //! - `validate`: ranges and combinations ([`Job::validate`]);
 //! - `convert`: the FE model, the solver settings and the elastic material ([`Job::model`],
 //!   [`Job::solver_settings`], [`Job::elastic`]);
+//! - `admission`: the memory and disk a job will need, estimated before anything is
+//!   allocated, and the refusal of a job too large ([`admission::estimate`]);
 //! - `fixtures` (tests only, feature `fixtures`): the shared test jobs of `fixtures/jobs/`.
 
+pub mod admission;
+mod arrays;
 mod convert;
 #[cfg(any(test, feature = "fixtures"))]
 pub mod fixtures;
 mod load;
+mod material;
 mod schema;
 mod validate;
 
+pub use load::MAX_JOB_FILE_BYTES;
 pub use schema::{
     ComponentChoice, Compression, Continuum, ElementChoice, Integration, Job, LoadingSection,
     MaterialSection, MeshKind, MeshSection, Moving, NewtonSection, OutputSection,
     PAPER_LINEAR_RANGE, PlatenChoice, Prescribed, PressureLoad, RampChoice, WorkersSection,
 };
+pub use validate::MAX_TANGENT_STRAIN;

@@ -1,10 +1,54 @@
 //! Reading a job: TOML text or a file. Parse errors (unknown keys, wrong types) carry the
 //! line and column from the TOML parser and name the file ([`Error::JobFile`]); every job read
-//! here is validated.
+//! here is validated. Only a regular file of at most [`MAX_JOB_FILE_BYTES`] is read: a device
+//! (`/dev/zero`), a FIFO or a directory is refused naming it.
 
 use crate::schema::Job;
 use cosdem_fem::error::{Error, Result};
+use cosdem_fem::gmsh::file_kind;
+use std::io::Read;
 use std::path::Path;
+
+/// Largest job file read (16 MiB): a job is a few kB of TOML; the largest legitimate one (a
+/// long explicit `radii` list of [`cosdem_dem::spec::MAX_DISCS`] radii) stays below it.
+pub const MAX_JOB_FILE_BYTES: u64 = 16 << 20;
+
+/// The text of the regular file `path`, at most [`MAX_JOB_FILE_BYTES`] bytes of it.
+fn read_job_file(path: &Path) -> Result<String> {
+    let err = |message: String| Error::JobFile { file: path.display().to_string(), message };
+    let too_large = |size: u64| {
+        err(format!(
+            "{size} bytes ({:.1} MiB) is more than the {} MiB (MAX_JOB_FILE_BYTES) a job file may hold",
+            size as f64 / f64::from(1 << 20),
+            MAX_JOB_FILE_BYTES >> 20
+        ))
+    };
+    let not_a_file = |meta: &std::fs::Metadata| {
+        err(format!(
+            "it is {}, not a regular file: a job file must be a plain file",
+            file_kind(meta)
+        ))
+    };
+    // Checked before opening: opening a FIFO blocks until a writer comes.
+    let meta = std::fs::metadata(path).map_err(|e| err(e.to_string()))?;
+    if !meta.is_file() {
+        return Err(not_a_file(&meta));
+    }
+    if meta.len() > MAX_JOB_FILE_BYTES {
+        return Err(too_large(meta.len()));
+    }
+    let file = std::fs::File::open(path).map_err(|e| err(e.to_string()))?;
+    let meta = file.metadata().map_err(|e| err(e.to_string()))?;
+    if !meta.is_file() {
+        return Err(not_a_file(&meta));
+    }
+    let mut bytes = Vec::with_capacity(meta.len().min(MAX_JOB_FILE_BYTES) as usize);
+    file.take(MAX_JOB_FILE_BYTES + 1).read_to_end(&mut bytes).map_err(|e| err(e.to_string()))?;
+    if bytes.len() as u64 > MAX_JOB_FILE_BYTES {
+        return Err(too_large(bytes.len() as u64));
+    }
+    String::from_utf8(bytes).map_err(|e| err(format!("not UTF-8 text: {e}")))
+}
 
 impl Job {
     /// Parses a job from TOML text; `origin` names the file in errors.
@@ -17,10 +61,7 @@ impl Job {
 
     /// Reads and validates a job file; relative paths inside it are resolved against it.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::JobFile {
-            file: path.display().to_string(),
-            message: e.to_string(),
-        })?;
+        let text = read_job_file(path)?;
         let mut job = Self::from_toml(&text, &path.display().to_string())?;
         if let Some(file) = &job.mesh.file
             && file.is_relative()
@@ -34,6 +75,7 @@ impl Job {
 
 #[cfg(test)]
 mod tests {
+    use super::MAX_JOB_FILE_BYTES;
     use crate::{Job, fixtures};
 
     /// A misspelt key is refused with its name, the file and where it is (line 7 of the
@@ -62,5 +104,56 @@ mod tests {
     fn a_missing_file_is_an_error_naming_it() {
         let err = Job::load(&fixtures::path("no-such-job")).unwrap_err().to_string();
         assert!(err.contains("no-such-job.toml"), "{err}");
+    }
+
+    /// A fresh directory for one test.
+    fn scratch(name: &str) -> std::path::PathBuf {
+        let dir = std::env::temp_dir().join(format!("cosdem-job-{name}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    /// `/dev/zero` as a job or mesh file was read until memory ran out: a device, a directory
+    /// and a FIFO are refused naming the path and what it is.
+    #[cfg(unix)]
+    #[test]
+    fn a_device_a_fifo_or_a_directory_is_refused_as_a_job_file() {
+        let dir = scratch("kinds");
+        let fifo = dir.join("job.toml");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        let mut cases = vec![
+            (std::path::PathBuf::from("/dev/zero"), "a character device"),
+            (dir.clone(), "a directory"),
+        ];
+        if made.is_ok_and(|s| s.success()) {
+            cases.push((fifo, "a FIFO"));
+        }
+        for (path, kind) in cases {
+            let err = Job::load(&path).unwrap_err().to_string();
+            assert!(err.contains(&path.display().to_string()) && err.contains(kind), "{err}");
+        }
+        std::fs::remove_dir_all(&dir).unwrap();
+        // The mesh file a job names is held to the mesh reader's rules.
+        let mut job = fixtures::load("gmsh-square");
+        job.mesh.file = Some("/dev/zero".into());
+        let err = job.model().unwrap_err().to_string();
+        assert!(
+            err.contains("mesh.file = \"/dev/zero\"") && err.contains("character device"),
+            "{err}"
+        );
+    }
+
+    /// A job file over 16 MiB is refused with its size and the limit, before it is read (a
+    /// sparse file: nothing is written to disk).
+    #[test]
+    fn a_job_file_over_the_limit_is_refused_and_the_mesh_file_is_checked() {
+        let dir = scratch("size");
+        let path = dir.join("huge.toml");
+        std::fs::File::create(&path).unwrap().set_len(MAX_JOB_FILE_BYTES + 1).unwrap();
+        let err = Job::load(&path).unwrap_err().to_string();
+        assert!(err.contains("huge.toml") && err.contains("16 MiB"), "{err}");
+        assert!(err.contains(&format!("{} bytes", MAX_JOB_FILE_BYTES + 1)), "{err}");
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

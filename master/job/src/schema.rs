@@ -92,7 +92,7 @@ pub struct MeshSection {
     /// Elements along y, rectangle only.
     pub ny: Option<usize>,
     /// Lower-left corner (m), rectangle only; default `[0, 0]`.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "crate::arrays::origin")]
     pub origin: [f64; 2],
     /// `q8` (default) or `q9`, rectangle only (a Gmsh file says its own).
     #[serde(default = "default_element")]
@@ -257,8 +257,18 @@ impl Default for LoadingSection {
 }
 
 /// `[material]`: what answers at the Gauss points.
+///
+/// Read through `material::RawMaterial` (a plain struct with the tag `kind` as a
+/// field) rather than as an internally tagged enum: serde reads a tagged enum's table into a
+/// buffer first, which loses the TOML positions, so an error anywhere in
+/// `[material.assembly]` would point at the `[material]` line instead of the key.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+#[serde(
+    tag = "kind",
+    rename_all = "snake_case",
+    deny_unknown_fields,
+    try_from = "crate::material::RawMaterial"
+)]
 pub enum MaterialSection {
     /// Linear-elastic Cosserat (THEORY.md Eq. 8): cheap, for checks and calibration.
     Elastic {
@@ -336,6 +346,7 @@ pub struct OutputSection {
     /// Write the VTK fields every this many steps (0: never).
     pub vtk_every: usize,
     /// Gauss points `[element, point]` whose particle snapshots are written.
+    #[serde(deserialize_with = "crate::arrays::snapshots")]
     pub snapshots: Vec<[u32; 2]>,
     /// Displacements (m) at which the equivalent-strain field is plotted.
     pub field_plots_at: Vec<f64>,

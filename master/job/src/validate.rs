@@ -1,32 +1,143 @@
-//! Range checks and combinations serde cannot express. Every error names the key and the value
-//! ([`Error::InvalidSetting`]).
+//! Range checks and combinations serde cannot express. Every error names the dotted key of
+//! the job file and the value ([`Error::InvalidSetting`]); numbers are printed with `{:?}`, so
+//! that `1e308` reads `1e308` and not as 309 digits.
 
 use crate::schema::{Job, MaterialSection, MeshKind, Moving};
 use cosdem_fem::error::{Error, Result};
 use cosdem_fem::mesh::MAX_ELEMENTS;
 use cosdem_fem::solve::{MAX_LOAD_STEPS, MIN_INCREMENT_FRACTION};
 use cosdem_fem::symmetry::Symmetry;
+use std::collections::BTreeMap;
+use std::sync::{LazyLock, Mutex};
 
-fn bad(field: &'static str, value: impl ToString, reason: &str) -> Error {
-    Error::InvalidSetting { field, value: value.to_string(), reason: reason.into() }
+/// Largest strain perturbation of the perturbation tangent (`tangent.strain`), checked by the
+/// assembly's own validation: a central difference needs a small step, and a step near 1
+/// makes the perturbed `det(F)` zero or negative.
+pub use cosdem_dem::spec::MAX_TANGENT_STRAIN;
+
+fn bad(field: &'static str, value: impl Into<String>, reason: &str) -> Error {
+    Error::InvalidSetting { field, value: value.into(), reason: reason.into() }
+}
+
+/// A number as the messages print it: `{:?}` (`1e308`, `1e-300`, `0.7`, `NaN`).
+fn num(v: f64) -> String {
+    format!("{v:?}")
 }
 
 fn positive(field: &'static str, v: f64) -> Result<f64> {
-    if v.is_finite() && v > 0.0 { Ok(v) } else { Err(bad(field, v, "must be finite and > 0")) }
+    if v.is_finite() && v > 0.0 { Ok(v) } else { Err(bad(field, num(v), "must be finite and > 0")) }
+}
+
+/// The job-file key of a field of `[material.assembly]` (`packing.side` ->
+/// `material.assembly.packing.side`). The DEM spec names its fields relative to the assembly
+/// with `&'static str`; the dotted keys are interned once each (the spec has a few dozen).
+fn assembly_key(field: &str) -> &'static str {
+    static KEYS: LazyLock<Mutex<BTreeMap<String, &'static str>>> = LazyLock::new(Mutex::default);
+    let mut keys = KEYS.lock().unwrap_or_else(|e| e.into_inner());
+    keys.entry(field.to_string())
+        .or_insert_with(|| Box::leak(format!("material.assembly.{field}").into_boxed_str()))
+}
+
+/// A value formatted by `Display` made readable: every number in it written out in more
+/// digits than `{:?}` needs (`1e308` displays as 309 digits) is printed with `{:?}`; the rest
+/// of the text is kept (`1e300 > r_max = 0.006`).
+fn readable(value: &str) -> String {
+    let numeric = |c: char| c.is_ascii_digit() || matches!(c, '.' | '-' | '+' | 'e' | 'E');
+    let mut out = String::with_capacity(value.len());
+    let mut rest = value;
+    while let Some(start) = rest.find(|c: char| c.is_ascii_digit() || c == '-') {
+        out.push_str(&rest[..start]);
+        let len = rest[start..].find(|c: char| !numeric(c)).unwrap_or(rest.len() - start);
+        let token = &rest[start..start + len];
+        match token.parse::<f64>() {
+            Ok(v) if num(v).len() < token.len() => out.push_str(&num(v)),
+            _ => out.push_str(token),
+        }
+        rest = &rest[start + len..];
+    }
+    out.push_str(rest);
+    out
+}
+
+/// The DEM spec's error as the job file's: the key with its `material.assembly.` prefix.
+fn assembly_error(e: cosdem_dem::Error) -> Error {
+    match e {
+        cosdem_dem::Error::InvalidSpec { field, value, reason } => Error::InvalidSetting {
+            field: assembly_key(field),
+            value: readable(&value),
+            reason: reason.into(),
+        },
+        other => bad("material.assembly", other.to_string(), "invalid assembly spec"),
+    }
 }
 
 impl Job {
     /// Checks every value that serde cannot: ranges and combinations.
     pub fn validate(&self) -> Result<()> {
+        self.validate_mesh()?;
+        self.validate_loading()?;
+        self.validate_material()?;
+        let n = &self.newton;
+        if n.max_iterations == 0 {
+            return Err(bad("newton.max_iterations", "0", "must be >= 1"));
+        }
+        for (name, v) in [
+            ("newton.force_tolerance", n.force_tolerance),
+            ("newton.displacement_tolerance", n.displacement_tolerance),
+            ("newton.tolerated_residual", n.tolerated_residual),
+            ("newton.forced_residual", n.forced_residual),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(bad(name, num(v), "must be finite and >= 0"));
+            }
+        }
+        if !(n.min_increment_fraction >= MIN_INCREMENT_FRACTION && n.min_increment_fraction <= 1.0)
+        {
+            return Err(bad(
+                "newton.min_increment_fraction",
+                num(n.min_increment_fraction),
+                "must be in [1e-12, 1]",
+            ));
+        }
+        if let Some(a) = self.accuracy {
+            if !(a > 0.0 && a < 1.0) {
+                return Err(bad(
+                    "accuracy",
+                    num(a),
+                    "must be a fraction in (0, 1), e.g. 0.05 for 5 %",
+                ));
+            }
+            if matches!(self.material, MaterialSection::Elastic { .. }) {
+                return Err(bad(
+                    "accuracy",
+                    num(a),
+                    "needs [material] kind = \"dem\": the measured trade is of DEM settings",
+                ));
+            }
+        }
+        positive("output.linear_range", self.output.linear_range)?;
+        for &d in &self.output.field_plots_at {
+            if !(d.is_finite() && d >= 0.0) {
+                return Err(bad("output.field_plots_at", num(d), "must be finite and >= 0 (m)"));
+            }
+        }
+        Ok(())
+    }
+
+    fn validate_mesh(&self) -> Result<()> {
         let m = &self.mesh;
         match m.kind {
             MeshKind::Rectangle => {
-                positive("mesh.lx", m.lx.ok_or_else(|| bad("mesh.lx", "missing", "required"))?)?;
-                positive("mesh.ly", m.ly.ok_or_else(|| bad("mesh.ly", "missing", "required"))?)?;
+                let lx = m.lx.ok_or_else(|| bad("mesh.lx", "missing", "required"))?;
+                let ly = m.ly.ok_or_else(|| bad("mesh.ly", "missing", "required"))?;
+                positive("mesh.lx", lx)?;
+                positive("mesh.ly", ly)?;
                 for (name, n) in [("mesh.nx", m.nx), ("mesh.ny", m.ny)] {
                     match n {
                         Some(n) if (1..=MAX_ELEMENTS).contains(&n) => {}
-                        Some(n) => return Err(bad(name, n, "must be in [1, 1 000 000]")),
+                        Some(n) => {
+                            return Err(bad(name, n.to_string(), "must be in [1, 1 000 000]"));
+                        }
                         None => return Err(bad(name, "missing", "required for a rectangle")),
                     }
                 }
@@ -40,16 +151,19 @@ impl Job {
                 }
                 for v in m.origin {
                     if !v.is_finite() {
-                        return Err(bad("mesh.origin", v, "must be finite"));
+                        return Err(bad("mesh.origin", num(v), "must be finite"));
                     }
                 }
+                rectangle_in_range(m.origin, [lx, ly], [nx, ny])?;
                 if m.file.is_some() {
                     return Err(bad("mesh.file", "given", "only for kind = \"gmsh\""));
                 }
                 let even = |name: &'static str, n: Option<usize>| match n {
-                    Some(n) if n % 2 == 1 => {
-                        Err(bad(name, n, "must be even to cut the mesh on its mid-line"))
-                    }
+                    Some(n) if n % 2 == 1 => Err(bad(
+                        name,
+                        n.to_string(),
+                        "must be even to cut the mesh on its mid-line",
+                    )),
                     _ => Ok(()),
                 };
                 if m.symmetry != Symmetry::None {
@@ -76,51 +190,78 @@ impl Job {
                 }
             }
         }
+        Ok(())
+    }
+
+    fn validate_loading(&self) -> Result<()> {
         let l = &self.loading;
         if l.steps == 0 || l.steps > MAX_LOAD_STEPS {
-            return Err(bad("loading.steps", l.steps, "must be in [1, 1 000 000]"));
+            return Err(bad("loading.steps", l.steps.to_string(), "must be in [1, 1 000 000]"));
         }
         if let Some(c) = &l.compression {
             positive("loading.compression.displacement", c.displacement)?;
+            // The platens would meet (or cross): every element inverts before the end.
+            if let (MeshKind::Rectangle, Some(ly)) = (self.mesh.kind, self.mesh.ly)
+                && c.displacement >= ly
+            {
+                return Err(bad(
+                    "loading.compression.displacement",
+                    num(c.displacement),
+                    &format!("must be less than the panel's height mesh.ly = {}", num(ly)),
+                ));
+            }
         }
         if let Some(inc) = l.increment {
             positive("loading.increment", inc)?;
             let Some(c) = &l.compression else {
-                return Err(bad("loading.increment", inc, "needs [loading.compression]"));
+                return Err(bad("loading.increment", num(inc), "needs [loading.compression]"));
             };
             if c.displacement / inc > MAX_LOAD_STEPS as f64 {
                 return Err(bad(
                     "loading.increment",
-                    inc,
-                    "too small: more than 1 000 000 load steps for the compression displacement",
+                    num(inc),
+                    &format!(
+                        "too small: {:e} load steps for loading.compression.displacement = {}, \
+                         more than 1 000 000",
+                        c.displacement / inc,
+                        num(c.displacement)
+                    ),
                 ));
             }
         }
         for p in &l.prescribed {
             if !p.value.is_finite() {
-                return Err(bad("loading.prescribed.value", p.value, "must be finite"));
+                return Err(bad("loading.prescribed.value", num(p.value), "must be finite"));
             }
         }
         for p in &l.pressure {
             if !p.value.is_finite() {
-                return Err(bad("loading.pressure.value", p.value, "must be finite"));
+                return Err(bad("loading.pressure.value", num(p.value), "must be finite"));
             }
         }
+        Ok(())
+    }
+
+    fn validate_material(&self) -> Result<()> {
         match &self.material {
             MaterialSection::Elastic { shear_modulus, poisson, cosserat_modulus, length } => {
                 positive("material.shear_modulus", *shear_modulus)?;
                 if !(*poisson > -1.0 && *poisson < 0.5) {
-                    return Err(bad("material.poisson", poisson, "must be in (-1, 0.5)"));
+                    return Err(bad("material.poisson", num(*poisson), "must be in (-1, 0.5)"));
                 }
                 if let Some(gc) = cosserat_modulus
                     && !(gc.is_finite() && *gc >= 0.0)
                 {
-                    return Err(bad("material.cosserat_modulus", gc, "must be finite and >= 0"));
+                    return Err(bad(
+                        "material.cosserat_modulus",
+                        num(*gc),
+                        "must be finite and >= 0",
+                    ));
                 }
                 if let Some(lc) = length
                     && !(lc.is_finite() && *lc >= 0.0)
                 {
-                    return Err(bad("material.length", lc, "must be finite and >= 0"));
+                    return Err(bad("material.length", num(*lc), "must be finite and >= 0"));
                 }
                 // Each value may be finite and the moduli they make still overflow.
                 let m = self.elastic().expect("elastic material");
@@ -128,64 +269,53 @@ impl Job {
                 if !d[..4].iter().flatten().all(|v| v.is_finite()) {
                     return Err(bad(
                         "material.shear_modulus",
-                        shear_modulus,
+                        num(*shear_modulus),
                         "with this Poisson's ratio and Cosserat modulus the elastic moduli overflow",
                     ));
                 }
                 if !d[4][4].is_finite() {
                     return Err(bad(
                         "material.length",
-                        m.length,
+                        num(m.length),
                         "the bending modulus 2 G lc^2 overflows",
                     ));
                 }
             }
-            MaterialSection::Dem { assembly } => assembly.validate().map_err(|e| {
-                Error::JobFile { file: "[material.assembly]".into(), message: e.to_string() }
-            })?,
-        }
-        let n = &self.newton;
-        if n.max_iterations == 0 {
-            return Err(bad("newton.max_iterations", 0, "must be >= 1"));
-        }
-        for (name, v) in [
-            ("newton.force_tolerance", n.force_tolerance),
-            ("newton.displacement_tolerance", n.displacement_tolerance),
-            ("newton.tolerated_residual", n.tolerated_residual),
-            ("newton.forced_residual", n.forced_residual),
-        ] {
-            if !(v.is_finite() && v >= 0.0) {
-                return Err(bad(name, v, "must be finite and >= 0"));
-            }
-        }
-        if !(n.min_increment_fraction >= MIN_INCREMENT_FRACTION && n.min_increment_fraction <= 1.0)
-        {
-            return Err(bad(
-                "newton.min_increment_fraction",
-                n.min_increment_fraction,
-                "in [1e-12, 1]",
-            ));
-        }
-        if let Some(a) = self.accuracy {
-            if !(a > 0.0 && a < 1.0) {
-                return Err(bad("accuracy", a, "must be a fraction in (0, 1), e.g. 0.05 for 5 %"));
-            }
-            if matches!(self.material, MaterialSection::Elastic { .. }) {
-                return Err(bad(
-                    "accuracy",
-                    a,
-                    "needs [material] kind = \"dem\": the measured trade is of DEM settings",
-                ));
-            }
-        }
-        positive("output.linear_range", self.output.linear_range)?;
-        for &d in &self.output.field_plots_at {
-            if !(d.is_finite() && d >= 0.0) {
-                return Err(bad("output.field_plots_at", d, "must be finite and >= 0 (m)"));
+            MaterialSection::Dem { assembly } => {
+                assembly.validate().map_err(assembly_error)?;
             }
         }
         Ok(())
     }
+}
+
+/// The rectangle's node coordinates are computed as `origin + l * i / (2 n)` (`i` up to
+/// `2 n`) and the element areas from products of coordinates: both must stay finite, and an
+/// element's area must not underflow (its Jacobian would be 0).
+fn rectangle_in_range(origin: [f64; 2], l: [f64; 2], n: [usize; 2]) -> Result<()> {
+    let reach = |k: usize| origin[k].abs() + l[k] * (2 * n[k]) as f64;
+    if !(4.0 * reach(0) * reach(1)).is_finite() {
+        let reason = "too large: the nodes' coordinates or their products overflow";
+        let span = |k: usize| l[k] * (2 * n[k]) as f64;
+        if origin[0].abs().max(origin[1].abs()) > span(0).max(span(1)) {
+            let value = format!("[{}, {}]", num(origin[0]), num(origin[1]));
+            return Err(bad("mesh.origin", value, reason));
+        }
+        let (key, v) = if span(0) >= span(1) { ("mesh.lx", l[0]) } else { ("mesh.ly", l[1]) };
+        return Err(bad(key, num(v), reason));
+    }
+    let area = (l[0] / n[0] as f64) * (l[1] / n[1] as f64);
+    if area < 1e-200 {
+        let (key, v) = if l[0] <= l[1] { ("mesh.lx", l[0]) } else { ("mesh.ly", l[1]) };
+        return Err(bad(
+            key,
+            num(v),
+            &format!(
+                "too small: an element's area (lx / nx) (ly / ny) = {area:e} m^2 is below 1e-200"
+            ),
+        ));
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -239,5 +369,110 @@ mod tests {
             let err = Job::from_toml(&with(bad), "j").unwrap_err().to_string();
             assert!(err.contains("output.linear_range"), "{bad}: {err}");
         }
+    }
+
+    /// Every message prints its numbers readably: no run of more than 17 digits (`1e308` used to
+    /// print as 309 digits, `1e-300` as 300 zeros).
+    fn readable(err: &str) -> bool {
+        let mut run = 0;
+        for c in err.chars() {
+            run = if c.is_ascii_digit() { run + 1 } else { 0 };
+            if run > 17 {
+                return false;
+            }
+        }
+        true
+    }
+
+    /// The issue's cases and the other extremes: each error names its dotted key and prints
+    /// the value as `{:?}` does (`1e308`, `1e-300`, `10.0`).
+    #[test]
+    fn errors_name_the_dotted_key_and_print_numbers_readably() {
+        let panel = minimal();
+        let dem = fixtures::text("dem-one-element");
+        let tangent = |t: &str| {
+            dem.replace("side = 0.1 }", &format!("side = 0.1 }}\ntangent = {{ kind = {t} }}"))
+        };
+        let cases = [
+            (panel.replace("lx = 1.0", "lx = 1e308"), "mesh.lx", "1e308"),
+            (panel.replace("ly = 1.0", "ly = 1e307"), "mesh.ly", "1e307"),
+            (panel.replace("ly = 1.0", "ly = 1.0\norigin = [1e308, 0]"), "mesh.origin", "1e308"),
+            (panel.replace("lx = 1.0", "lx = 1e-300"), "mesh.lx", "1e-300"),
+            (panel.replace("steps = 4", "increment = 1e-300"), "loading.increment", "1e-300"),
+            (
+                panel.replace("displacement = 0.01", "displacement = 1e308"),
+                "loading.compression.displacement",
+                "1e308",
+            ),
+            (panel.replace("poisson = 0.3", "poisson = 1e308"), "material.poisson", "1e308"),
+            (
+                panel.replace("shear_modulus = 1e7", "shear_modulus = 1e308"),
+                "material.shear_modulus",
+                "1e308",
+            ),
+            (format!("accuracy = 1e308\n{dem}"), "accuracy", "1e308"),
+            (
+                format!("{panel}\n[newton]\nmin_increment_fraction = 1e-300\n"),
+                "newton.min_increment_fraction",
+                "1e-300",
+            ),
+            (
+                format!("{panel}\n[output]\nfield_plots_at = [-1e308]\n"),
+                "output.field_plots_at",
+                "-1e308",
+            ),
+            (tangent("\"perturbation\", strain = 10"), "material.assembly.tangent.strain", "10.0"),
+            (
+                tangent("\"adaptive\", sliding = 0.5, strain = 1e308"),
+                "material.assembly.tangent.strain",
+                "1e308",
+            ),
+            (
+                tangent("\"perturbation\", strain = -1e308"),
+                "material.assembly.tangent.strain",
+                "-1e308",
+            ),
+            (dem.replace("radius = 0.005", "radius = 1e-300"), "material.assembly.packing", "0.1"),
+            (
+                dem.replace(
+                    "{ kind = \"hexagonal\", radius = 0.005, side = 0.1 }",
+                    "{ kind = \"random\", r_min = 1e300, r_max = 0.006, side = 0.1, seed = 1, \
+                     confining_stress = 1e5 }",
+                ),
+                "material.assembly.packing.r_min",
+                "1e300 > r_max = 0.006",
+            ),
+            (
+                dem.replace("[material.assembly]", "[material.assembly]\ndensity = -1e308"),
+                "material.assembly.density",
+                "-1e308",
+            ),
+        ];
+        for (text, key, value) in cases {
+            let err = Job::from_toml(&text, "j").unwrap_err().to_string();
+            assert!(err.contains(key), "{key}: {err}");
+            assert!(err.contains(value), "{key}: no {value} in {err}");
+            assert!(readable(&err), "{key}: {err}");
+        }
+        // The DEM's own messages, relative to the assembly, get the job file's prefix.
+        let err = Job::from_toml(&tangent("\"perturbation\", strain = 0.0"), "j").unwrap_err();
+        assert!(
+            matches!(&err, cosdem_fem::Error::InvalidSetting { field, value, .. }
+                if *field == "material.assembly.tangent.strain" && value == "0.0"),
+            "{err}"
+        );
+        // A usual strain still passes.
+        Job::from_toml(&tangent("\"perturbation\", strain = 1e-5"), "j").unwrap();
+    }
+
+    /// Numbers written out in full by the DEM's messages are shortened, the rest is kept.
+    #[test]
+    fn long_numbers_are_shortened_and_the_rest_kept() {
+        let long = format!("{} > r_max = 0.006 (about 3e9 discs)", 1e300);
+        assert_eq!(super::readable(&long), "1e300 > r_max = 0.006 (about 3e9 discs)");
+        assert_eq!(super::readable("0.1"), "0.1");
+        assert_eq!(super::readable("12 radii"), "12 radii");
+        assert_eq!(super::readable(&(-1e-300f64).to_string()), "-1e-300");
+        assert_eq!(super::readable("k_n = 6.7e7, x-y"), "k_n = 6.7e7, x-y");
     }
 }

@@ -44,16 +44,54 @@ pub enum Error {
 /// Result alias of the worker crate.
 pub type Result<T> = std::result::Result<T, Error>;
 
-/// Builds an [`Error::InvalidSpec`].
-pub(crate) fn invalid(
-    field: &'static str,
-    value: impl std::fmt::Display,
-    reason: &'static str,
-) -> Error {
-    Error::InvalidSpec { field, value: value.to_string(), reason }
+/// A refused value as a message shows it: numbers in their shortest form (`1e308`, not 309
+/// digits), text as it is.
+pub(crate) trait Shown {
+    /// The value's text.
+    fn shown(&self) -> String;
 }
 
-/// Checks `value` is finite and `> 0`.
+impl Shown for f64 {
+    fn shown(&self) -> String {
+        format!("{self:?}")
+    }
+}
+
+impl Shown for String {
+    fn shown(&self) -> String {
+        self.clone()
+    }
+}
+
+impl Shown for str {
+    fn shown(&self) -> String {
+        self.to_string()
+    }
+}
+
+impl<T: Shown + ?Sized> Shown for &T {
+    fn shown(&self) -> String {
+        (**self).shown()
+    }
+}
+
+macro_rules! shown_as_display {
+    ($($t:ty),*) => {$(
+        impl Shown for $t {
+            fn shown(&self) -> String {
+                self.to_string()
+            }
+        }
+    )*};
+}
+shown_as_display!(u32, u64, usize, i32, i64);
+
+/// Builds an [`Error::InvalidSpec`].
+pub(crate) fn invalid(field: &'static str, value: impl Shown, reason: &'static str) -> Error {
+    Error::InvalidSpec { field, value: value.shown(), reason }
+}
+
+/// Checks `value` is finite and `> 0` (a refused value prints as `1e308`, not in full).
 pub(crate) fn positive(field: &'static str, value: f64) -> Result<()> {
     if value.is_finite() && value > 0.0 {
         Ok(())
@@ -68,5 +106,20 @@ pub(crate) fn non_negative(field: &'static str, value: f64) -> Result<()> {
         Ok(())
     } else {
         Err(invalid(field, value, "must be finite and >= 0"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A refused 1e308 reads `1e308` (Display would print 309 digits), 1e-300 `1e-300`.
+    #[test]
+    fn refused_numbers_print_short() {
+        let e = positive("packing.radius", -1e308).unwrap_err().to_string();
+        assert!(e.contains("-1e308") && e.len() < 120, "{e}");
+        let e = invalid("relaxation.safety", 1e-300, "must be in (0, 1]").to_string();
+        assert!(e.contains("= 1e-300:"), "{e}");
+        assert!(invalid("packing.radii", 3usize, "x").to_string().contains("= 3:"));
     }
 }

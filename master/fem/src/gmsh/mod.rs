@@ -34,6 +34,8 @@
 mod ascii;
 mod binary;
 mod build;
+mod file;
+pub use file::file_kind;
 mod records;
 mod v22;
 mod v41;
@@ -52,6 +54,32 @@ pub enum GmshError {
         path: PathBuf,
         /// The operating-system error.
         source: std::io::Error,
+    },
+    /// The path names no regular file (a directory, a device such as `/dev/zero`, a FIFO).
+    #[error("{}: cannot read mesh file: it is {kind}, not a regular file", path.display())]
+    NotAFile {
+        /// The path.
+        path: PathBuf,
+        /// What it is instead (`a directory`, `a character device`, ...).
+        kind: &'static str,
+    },
+    /// The file is larger than any mesh the solver can take ([`MAX_MESH_FILE_BYTES`]).
+    #[error(
+        "{}: cannot read mesh file: {} bytes ({:.1} MiB) is more than the {} MiB \
+         (MAX_MESH_FILE_BYTES) of a mesh of MAX_ELEMENTS = {} quadrilaterals",
+        path.display(),
+        size,
+        *size as f64 / MIB,
+        MAX_MESH_FILE_BYTES >> 20,
+        crate::mesh::MAX_ELEMENTS
+    )]
+    TooLarge {
+        /// The file.
+        path: PathBuf,
+        /// Its size, or the bytes read before the limit was passed.
+        size: u64,
+        /// The limit (bytes).
+        limit: u64,
     },
     /// A line does not have the expected content.
     #[error("{file}:{line}: {message}")]
@@ -140,6 +168,20 @@ pub enum GmshError {
     },
 }
 
+/// Bytes per MiB, for the messages.
+const MIB: f64 = (1u64 << 20) as f64;
+
+/// Largest mesh file read (bytes): what a mesh of [`MAX_ELEMENTS`](crate::mesh::MAX_ELEMENTS)
+/// 9-node quadrilaterals, the most the solver takes, needs in ASCII with room to spare: about
+/// 4 nodes per element at 128 bytes a line (a tag and three coordinates at full precision),
+/// and twice as many element lines as quadrilaterals (the boundary lines and points) at 256
+/// bytes (a tag, the type, the tags and up to 9 node tags). About 1 GB; a larger file cannot
+/// hold a mesh the solver takes, and [`read_msh`] refuses it before reading.
+pub const MAX_MESH_FILE_BYTES: u64 = {
+    let elements = crate::mesh::MAX_ELEMENTS as u64;
+    4 * elements * 128 + 2 * elements * 256
+};
+
 /// Result of the mesh readers.
 pub type Result<T> = std::result::Result<T, GmshError>;
 
@@ -215,10 +257,11 @@ pub struct RawMesh {
     pub edge_groups: BTreeMap<String, Vec<Vec<usize>>>,
 }
 
-/// Reads a `.msh` file: ASCII 2.2, ASCII 4.1 or binary 4.1.
+/// Reads a `.msh` file: ASCII 2.2, ASCII 4.1 or binary 4.1. Only a regular file is read
+/// ([`GmshError::NotAFile`] for a directory, a device or a FIFO), and only up to
+/// [`MAX_MESH_FILE_BYTES`] ([`GmshError::TooLarge`]).
 pub fn read_msh(path: &Path) -> Result<RawMesh> {
-    let bytes =
-        std::fs::read(path).map_err(|source| GmshError::Io { path: path.to_path_buf(), source })?;
+    let bytes = file::read_regular(path, MAX_MESH_FILE_BYTES)?;
     parse_bytes_named(&bytes, &path.display().to_string())
 }
 

@@ -70,6 +70,13 @@ impl Mesh {
     pub fn from_description(desc: MeshDescription) -> Result<Self> {
         let MeshDescription { nodes, elements, node_groups, edge_groups } = desc;
         let first = elements.first().ok_or_else(|| invalid("elements", 0, "no elements"))?;
+        if elements.len() > MAX_ELEMENTS {
+            return Err(invalid(
+                "elements",
+                elements.len(),
+                format!("more than MAX_ELEMENTS = {MAX_ELEMENTS} elements"),
+            ));
+        }
         let kind = match first.len() {
             8 => ElementKind::Q8,
             9 => ElementKind::Q9,

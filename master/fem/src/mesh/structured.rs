@@ -28,7 +28,7 @@ impl Mesh {
             if !(v.is_finite() && (v > 0.0 || field == "origin")) {
                 return Err(Error::InvalidMesh {
                     field,
-                    value: v.to_string(),
+                    value: format!("{v:?}"),
                     reason: "must be finite (and > 0 for lx, ly)".into(),
                 });
             }
@@ -125,5 +125,17 @@ mod tests {
         let m9 = Mesh::rectangle(ElementKind::Q9, 1.0, 1.0, 2, 2, [0.0, 0.0]).unwrap();
         assert_eq!(m9.n_nodes(), 25);
         assert!(m.node_set("nope").unwrap_err().to_string().contains("top"));
+    }
+
+    /// A described mesh (a Gmsh file) is held to the rectangle's cap too.
+    #[test]
+    fn a_description_over_max_elements_is_refused() {
+        let desc = MeshDescription {
+            nodes: vec![[0.0, 0.0]; 8],
+            elements: vec![vec![0; 8]; MAX_ELEMENTS + 1],
+            ..Default::default()
+        };
+        let err = Mesh::from_description(desc).unwrap_err().to_string();
+        assert!(err.contains("MAX_ELEMENTS") && err.contains("1000001"), "{err}");
     }
 }

@@ -109,18 +109,18 @@ impl SolverSettings {
     pub fn steps_for_increment(total: f64, increment: f64) -> Result<usize> {
         if !(increment.abs() > 0.0 && increment.is_finite() && total.is_finite()) {
             return Err(Error::InvalidSetting {
-                field: "increment",
-                value: increment.to_string(),
-                reason: "must be finite and non-zero".into(),
+                field: "loading.increment",
+                value: format!("{increment:?}"),
+                reason: format!("must be finite and non-zero (with a total of {total:?})"),
             });
         }
         let steps = ((total / increment).abs() - 1e-9).ceil().max(1.0);
         if steps.is_nan() || steps > MAX_LOAD_STEPS as f64 {
             return Err(Error::InvalidSetting {
-                field: "increment",
-                value: increment.to_string(),
+                field: "loading.increment",
+                value: format!("{increment:?}"),
                 reason: format!(
-                    "gives {steps:e} load steps for a total of {total}: more than MAX_LOAD_STEPS = \
+                    "gives {steps:e} load steps for a total of {total:?}: more than MAX_LOAD_STEPS = \
                      {MAX_LOAD_STEPS}"
                 ),
             });
@@ -128,37 +128,80 @@ impl SolverSettings {
         Ok(steps as usize)
     }
 
+    /// Checks every field; an error names the field as the job file's key (`newton.*`,
+    /// `loading.steps`) and prints numbers with `{:?}`.
     pub(super) fn check(&self) -> Result<()> {
         let bad = |field: &'static str, value: String, reason: &str| {
             Err(Error::InvalidSetting { field, value, reason: reason.into() })
         };
         if self.steps == 0 || self.steps > MAX_LOAD_STEPS {
-            return bad("steps", self.steps.to_string(), "must be in [1, MAX_LOAD_STEPS = 10^6]");
+            return bad(
+                "loading.steps",
+                self.steps.to_string(),
+                "must be in [1, MAX_LOAD_STEPS = 10^6]",
+            );
         }
         if self.max_iterations == 0 {
-            return bad("max_iterations", "0".into(), "must be >= 1");
+            return bad("newton.max_iterations", "0".into(), "must be >= 1");
         }
-        if !(self.force_tolerance >= 0.0 && self.displacement_tolerance >= 0.0) {
-            return bad("tolerances", format!("{self:?}"), "must be >= 0");
+        for (field, v) in [
+            ("newton.force_tolerance", self.force_tolerance),
+            ("newton.displacement_tolerance", self.displacement_tolerance),
+        ] {
+            if v.is_nan() || v < 0.0 {
+                return bad(field, format!("{v:?}"), "must be >= 0");
+            }
         }
         if !(self.min_increment_fraction >= MIN_INCREMENT_FRACTION
             && self.min_increment_fraction <= 1.0)
         {
             return bad(
-                "min_increment_fraction",
-                self.min_increment_fraction.to_string(),
-                "in [1e-12, 1]",
+                "newton.min_increment_fraction",
+                format!("{:?}", self.min_increment_fraction),
+                "must be in [1e-12, 1]",
             );
         }
-        if !(self.tolerated_residual.is_finite() && self.tolerated_residual >= 0.0) {
-            return bad("tolerated_residual", self.tolerated_residual.to_string(), "finite, >= 0");
-        }
-        if !(self.forced_residual.is_finite() && self.forced_residual >= 0.0) {
-            return bad("forced_residual", self.forced_residual.to_string(), "finite, >= 0");
+        for (field, v) in [
+            ("newton.tolerated_residual", self.tolerated_residual),
+            ("newton.forced_residual", self.forced_residual),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return bad(field, format!("{v:?}"), "must be finite and >= 0");
+            }
         }
         if self.growth.is_nan() || self.growth < 1.0 {
-            return bad("growth", self.growth.to_string(), "must be >= 1");
+            return bad("growth", format!("{:?}", self.growth), "must be >= 1");
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The errors name the job file's key and print numbers as `{:?}` does (`1e-300`, not 300
+    /// zeros; the whole settings struct was printed for a bad tolerance).
+    #[test]
+    fn errors_name_the_key_and_print_numbers_readably() {
+        let err = SolverSettings::steps_for_increment(1e308, 1e-300).unwrap_err().to_string();
+        assert!(err.contains("loading.increment = 1e-300") && err.contains("1e308"), "{err}");
+        assert!(err.len() < 200, "{err}");
+        let err = SolverSettings::steps_for_increment(0.1, 0.0).unwrap_err().to_string();
+        assert!(err.contains("loading.increment = 0.0"), "{err}");
+        let check = |f: fn(&mut SolverSettings)| {
+            let mut s = SolverSettings::default();
+            f(&mut s);
+            s.check().unwrap_err().to_string()
+        };
+        let err = check(|s| s.displacement_tolerance = -1e308);
+        assert!(err.contains("newton.displacement_tolerance = -1e308"), "{err}");
+        assert!(!err.contains("max_iterations"), "the whole settings printed: {err}");
+        let err = check(|s| s.min_increment_fraction = 1e-300);
+        assert!(err.contains("newton.min_increment_fraction = 1e-300"), "{err}");
+        let err = check(|s| s.forced_residual = 1e308 * 10.0);
+        assert!(err.contains("newton.forced_residual = inf"), "{err}");
+        let err = check(|s| s.steps = 0);
+        assert!(err.contains("loading.steps = 0"), "{err}");
     }
 }

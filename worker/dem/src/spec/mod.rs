@@ -28,12 +28,15 @@
 //! "strain": 1e-5}`.
 //!
 //! One module per part of the spec, each with the checks of its own fields: `packing`,
-//! `contact`, `boundary`, `relaxation` and `tangent`.
+//! `contact`, `boundary`, `relaxation` and `tangent`; `size` gives the disc count a spec
+//! builds ([`AssemblySpec::disc_count_hint`]) and a bound on its exported state's bytes
+//! ([`state_bytes`]) before anything is built.
 
 mod boundary;
 mod contact;
 mod packing;
 mod relaxation;
+mod size;
 mod tangent;
 
 pub use boundary::BoundarySpec;
@@ -42,7 +45,8 @@ pub use packing::{MAX_DISCS, PackingSpec};
 pub use relaxation::{
     Criterion, Driver, FIRE_CEILING, MAX_RELAXATION_STEPS, MAX_SUBSTEPS, RelaxationSpec,
 };
-pub use tangent::{SECANT_RANGE, TangentKind};
+pub use size::{STATE_BYTES_PER_DISC, STATE_ENVELOPE_BYTES, STATE_FIXED_BYTES, state_bytes};
+pub use tangent::{MAX_TANGENT_STRAIN, SECANT_RANGE, TangentKind};
 
 use crate::error::{Result, positive};
 use serde::{Deserialize, Deserializer, Serialize};

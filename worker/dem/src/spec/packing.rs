@@ -89,7 +89,7 @@ impl PackingSpec {
                     if r_min > r_max {
                         return Err(invalid(
                             "packing.r_min",
-                            format!("{r_min} > r_max = {r_max}"),
+                            format!("{r_min:?} > r_max = {r_max:?}"),
                             "inverted radius range: r_min must be <= r_max",
                         ));
                     }
@@ -125,7 +125,7 @@ impl PackingSpec {
         if n.is_nan() || n > MAX_DISCS as f64 {
             return Err(invalid(
                 "packing.side",
-                format!("{} (about {n:.3e} discs)", self.side()),
+                format!("{:?} (about {n:.3e} discs)", self.side()),
                 "side / radius too large: more than MAX_DISCS = 1 000 000 discs in one assembly",
             ));
         }

@@ -51,13 +51,26 @@ pub enum TangentKind {
 /// matrix).
 pub const SECANT_RANGE: (f64, f64) = (0.05, 1.0);
 
+/// Largest perturbation strain of a probed tangent: a larger one is no tangent any more (10
+/// turns the assembly inside out: a deformation gradient with a negative determinant).
+pub const MAX_TANGENT_STRAIN: f64 = 0.01;
+
+/// Checks a perturbation strain: finite, positive and at most [`MAX_TANGENT_STRAIN`].
+fn strain(value: f64) -> Result<()> {
+    positive("tangent.strain", value)?;
+    if value > MAX_TANGENT_STRAIN {
+        return Err(invalid("tangent.strain", value, "must be at most 0.01 (MAX_TANGENT_STRAIN)"));
+    }
+    Ok(())
+}
+
 impl TangentKind {
     /// Checks the perturbation strain and the sliding fraction.
     pub(super) fn validate(&self) -> Result<()> {
         match self {
-            TangentKind::Perturbation { strain } => positive("tangent.strain", *strain)?,
-            TangentKind::Adaptive { sliding, strain } => {
-                positive("tangent.strain", *strain)?;
+            TangentKind::Perturbation { strain: s } => strain(*s)?,
+            TangentKind::Adaptive { sliding, strain: s } => {
+                strain(*s)?;
                 if !(0.0..=1.0).contains(sliding) {
                     return Err(invalid("tangent.sliding", sliding, "must be in [0, 1]"));
                 }
