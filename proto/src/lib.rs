@@ -12,10 +12,13 @@ pub mod v1 {
 
 /// Wire -> domain conversions, validating as they go.
 pub mod from_proto;
+/// A peer's text made safe to log ([`printable`]).
+pub mod text;
 /// Domain -> wire conversions.
 pub mod to_proto;
 
 pub use from_proto::ConvertError;
+pub use text::printable;
 
 /// The protocol version a master and a worker must agree on at handshake. 2: a SolveBatch
 /// may carry the commit of the previous step (a worker of protocol 1 would ignore it). 3: the

@@ -3,7 +3,7 @@
 //! back to ride on the next SolveBatch), rollback, export for a checkpoint, import from one,
 //! and the master's copies ([`replay`](crate::replay)).
 
-use crate::fanout::{Job, fan_out};
+use crate::fanout::Job;
 use crate::link::{PendingCommit, is_worker_failure};
 use crate::membership::refused;
 use crate::recovery::{Redo, Rounds};
@@ -200,32 +200,49 @@ impl Pool {
 
     /// Exports every assembly's committed state from its owner now (a checkpoint needs the
     /// states of the last committed step, not those of the last periodic export), storing
-    /// them as the failover copies. A worker that fails here is an error: the checkpoint is
-    /// not written and the next step's failover handles the loss.
+    /// them as the failover copies. A worker lost here takes the loss path as in a solve: its
+    /// assemblies are restored on the live workers from the committed history (the stored
+    /// states and the increments committed since, held-back commits included) and exported
+    /// from their new owners, so the states are those the lost worker would have given, to the
+    /// byte. Only a worker that refuses the export (a status that is not a worker failure), or
+    /// no worker left, is an error.
     pub(crate) async fn export_all(&mut self) -> Result<(), MaterialError> {
         self.flush_deferred().await?;
+        let mut pending: Vec<GaussPointId> = self.owner.keys().copied().collect();
+        let mut rounds = Rounds::default();
         let t = self.config.call_timeout;
-        let jobs = (0..self.workers.len())
-            .filter(|w| self.workers[*w].alive)
-            .filter_map(|w| {
-                let ids = self.owned_by(w);
-                if ids.is_empty() {
-                    return None;
-                }
-                let link = self.workers[w].link.clone();
-                let job: Job<_> = Box::pin(async move { link.export(&ids, t).await });
-                Some((w, job))
-            })
-            .collect();
-        for (w, r) in fan_out(jobs).await {
-            match r {
-                Ok(states) => {
-                    for s in states {
-                        self.history.store(s);
-                    }
-                }
-                Err(s) => return Err(self.unavailable(w, "export for a checkpoint", &s)),
+        while !pending.is_empty() {
+            if let Some(done) = rounds.start(self.workers.len()) {
+                return Err(MaterialError::Unavailable(format!(
+                    "export for a checkpoint still failing after {done} rounds of worker losses"
+                )));
             }
+            let mut by_worker: BTreeMap<usize, Vec<GaussPointId>> = BTreeMap::new();
+            for id in &pending {
+                by_worker.entry(self.owner[id]).or_default().push(*id);
+            }
+            let jobs = by_worker
+                .into_iter()
+                .map(|(w, ids)| {
+                    let link = self.workers[w].link.clone();
+                    let job: Job<_> = Box::pin(async move { link.export(&ids, t).await });
+                    (w, job)
+                })
+                .collect();
+            let lost = self
+                .round(jobs, is_worker_failure, |pool, w, r| {
+                    let states =
+                        r.map_err(|s| pool.unavailable(w, "export for a checkpoint", &s))?;
+                    for s in states {
+                        pool.history.store(s);
+                    }
+                    Ok(())
+                })
+                .await?;
+            if lost.is_empty() {
+                break;
+            }
+            pending = self.recover(lost, Redo::Export).await?;
         }
         Ok(())
     }

@@ -10,6 +10,17 @@
 //! worker's next `SolveBatch` ([`PoolConfig::defer_commits`]): one round trip per load step
 //! instead of two.
 //!
+//! # Limits
+//! An address of no `host:port` form is an error naming it; an endpoint whose handshake fails
+//! (not a cosdem worker) is skipped with a warning, a worker of another protocol version or
+//! with another token is refused. A worker's share of a creation goes in requests within its
+//! per-request caps ([`cosdem_worker::Limits::MAX_IDS_PER_REQUEST`], the disc cap of its
+//! memory), each bounded by [`PoolConfig::create_deadline`]; calls that carry assembly states
+//! are split to stay within the message limit ([`PoolConfig::max_message_bytes`] and the
+//! worker's), and a state that cannot fit is an error naming the limit and the sizes. A
+//! job's in-process workers are at most the machine's cores ([`Pool::in_process_workers`]).
+//! Text from a worker (its build id, its statuses) is made printable before it is logged.
+//!
 //! # Runtime
 //! `Material` is synchronous; the pool owns a small multi-threaded tokio runtime and blocks
 //! on it. So its methods must not be called from inside an async context (call them from a
@@ -42,6 +53,8 @@
 //! [`PoolConfig::rebalance_threshold`], assemblies migrate (import of the stored committed
 //! state on the new owner, drop on the old one).
 
+/// Worker addresses: their form checked, their names resolved.
+mod address;
 /// Placement and rebalancing of assemblies: pure functions on costs and capacities.
 mod balance;
 /// Commit, rollback, export and import of the committed states.
@@ -56,6 +69,8 @@ mod fanout;
 mod link;
 /// The workers: building a pool, admission, placement of new assemblies.
 mod membership;
+/// Calls carrying states split within the message limit; failures for size named.
+mod message;
 /// The step boundary: admission, rebalancing, migration.
 mod migration;
 /// The one worker-loss path: mark dead, restore, redo.
@@ -63,7 +78,7 @@ mod recovery;
 pub mod replay;
 
 pub use balance::Cost;
-pub use config::{ClientTls, PoolConfig};
+pub use config::{CREATE_SECONDS_PER_DISC_POW, ClientTls, PoolConfig};
 pub use direct::DirectDem;
 pub use link::WorkerInfo;
 

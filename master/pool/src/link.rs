@@ -2,12 +2,15 @@
 //! called directly), handshake and calls. The only place in the master that touches prost
 //! types.
 
+use crate::message::{groups, oversized};
 use cosdem_common::micro::{AssemblyInfo, AssemblyRequest, AssemblyState};
 use cosdem_common::{GaussPointId, MacroDeformation, MicroResponse};
 use cosdem_proto::v1 as pb;
 use cosdem_proto::v1::micro_solver_client::MicroSolverClient;
 use cosdem_proto::{PROTOCOL_VERSION, from_proto, to_proto};
 use cosdem_worker::{AttachToken, MicroModel, Token, WorkerConfig};
+use std::collections::BTreeMap;
+use std::sync::{Arc, Mutex};
 use std::time::Duration;
 use tonic::body::Body;
 use tonic::service::interceptor::InterceptedService;
@@ -46,8 +49,10 @@ pub struct WorkerInfo {
     pub cores: u32,
     /// Its memory (bytes; 0 = unknown).
     pub memory_bytes: u64,
-    /// Its build.
+    /// Its build (made printable: [`cosdem_proto::printable`]).
     pub build_id: String,
+    /// Its message limit (bytes; 0 = not said).
+    pub max_message_bytes: u64,
 }
 
 /// A commit held back by the pool to ride on the worker's next SolveBatch (see
@@ -71,6 +76,11 @@ pub struct Link {
     pub client: Client,
     /// What it said at handshake.
     pub info: WorkerInfo,
+    /// The message limit this side enforces (`PoolConfig::max_message_bytes`).
+    max_message: usize,
+    /// The disc count of each assembly this worker reported (created, imported, exported):
+    /// what an oversized message's error names.
+    discs: Arc<Mutex<BTreeMap<GaussPointId, u64>>>,
 }
 
 /// Statuses that mean "this worker is gone or unusable": its assemblies move elsewhere.
@@ -135,6 +145,7 @@ pub async fn connect_tcp(
         addr.to_string(),
         client(over_channel(channel), c.token.clone(), c.max_message_bytes),
         c.connect_timeout,
+        c.max_message_bytes,
     )
     .await
 }
@@ -160,7 +171,7 @@ pub async fn connect_duplex(
         .connect_with_connector(connector)
         .await
         .map_err(|e| Status::unavailable(format!("connect {name}: {e}")))?;
-    handshake(name, client(over_channel(channel), token, max_message), timeout).await
+    handshake(name, client(over_channel(channel), token, max_message), timeout, max_message).await
 }
 
 /// A worker inside this process with no transport: its service
@@ -180,7 +191,7 @@ pub async fn connect_direct<M: MicroModel>(
         ServiceExt::<http::Request<Body>>::map_err(service, |e| -> TransportError { match e {} });
     let transport = Transport::new(service);
     let max = config.limits.max_message_bytes;
-    handshake(name, client(transport, config.token.clone(), max), timeout).await
+    handshake(name, client(transport, config.token.clone(), max), timeout, max).await
 }
 
 fn with_timeout<T>(msg: T, timeout: Duration) -> Request<T> {
@@ -196,23 +207,48 @@ async fn bounded<T>(
     f: impl Future<Output = Result<T, Status>>,
 ) -> Result<T, Status> {
     match tokio::time::timeout(timeout + Duration::from_millis(250), f).await {
-        Ok(r) => r,
+        Ok(r) => r.map_err(from_peer),
         Err(_) => Err(Status::deadline_exceeded(format!("no answer within {timeout:?}"))),
     }
 }
 
-async fn handshake(name: String, mut client: Client, timeout: Duration) -> Result<Link, Status> {
+/// A status as a peer (or the transport under it) gave it, its message made safe to log and
+/// print ([`cosdem_proto::printable`]: a newline or an ANSI escape from a hostile worker must
+/// not forge the master's log lines); the code is kept.
+fn from_peer(s: Status) -> Status {
+    let message = cosdem_proto::printable(s.message());
+    if message == s.message() { s } else { Status::new(s.code(), message) }
+}
+
+/// The Handshake call, and the check of what the worker answers: its protocol version must
+/// be ours (FAILED_PRECONDITION naming both otherwise: a worker of another version refuses our
+/// calls, or worse, misreads them).
+async fn handshake(
+    name: String,
+    mut client: Client,
+    timeout: Duration,
+    max_message: usize,
+) -> Result<Link, Status> {
     let req = pb::HandshakeRequest {
         protocol_version: PROTOCOL_VERSION,
         master_build_id: concat!("cosdem-master ", env!("CARGO_PKG_VERSION")).into(),
     };
     let reply = bounded(timeout, client.handshake(with_timeout(req, timeout))).await?.into_inner();
+    if reply.protocol_version != PROTOCOL_VERSION {
+        return Err(Status::failed_precondition(format!(
+            "protocol version mismatch: worker {name} speaks {}, this master speaks \
+             {PROTOCOL_VERSION} (build {})",
+            reply.protocol_version,
+            cosdem_proto::printable(&reply.build_id)
+        )));
+    }
     let info = WorkerInfo {
         cores: reply.cores.max(1),
         memory_bytes: reply.memory_bytes,
-        build_id: reply.build_id,
+        build_id: cosdem_proto::printable(&reply.build_id),
+        max_message_bytes: reply.max_message_bytes,
     };
-    Ok(Link { name, client, info })
+    Ok(Link { name, client, info, max_message, discs: Arc::default() })
 }
 
 fn bad_reply(e: impl std::fmt::Display) -> Status {
@@ -220,6 +256,40 @@ fn bad_reply(e: impl std::fmt::Display) -> Status {
 }
 
 impl Link {
+    /// The largest message both sides take.
+    fn limit(&self) -> u64 {
+        let ours = self.max_message as u64;
+        match self.info.max_message_bytes {
+            0 => ours,
+            theirs => ours.min(theirs),
+        }
+    }
+
+    fn lock_discs(&self) -> std::sync::MutexGuard<'_, BTreeMap<GaussPointId, u64>> {
+        self.discs.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// Remembers the disc counts the worker reported.
+    fn record(&self, counts: impl IntoIterator<Item = (GaussPointId, u64)>) {
+        self.lock_discs().extend(counts);
+    }
+
+    /// The known disc count of each of `ids`.
+    fn sizes(&self, ids: &[GaussPointId]) -> Vec<(GaussPointId, Option<u64>)> {
+        let d = self.lock_discs();
+        ids.iter().map(|id| (*id, d.get(id).copied())).collect()
+    }
+
+    /// A bound on the bytes of `id`'s exported state (its disc count unknown: 0 discs).
+    fn state_size(&self, id: &GaussPointId) -> u64 {
+        cosdem_dem::spec::state_bytes(self.lock_discs().get(id).copied().unwrap_or(0))
+    }
+
+    /// `s`, naming the limits and the sizes of `ids` if it is a failure for size.
+    fn sized(&self, call: &str, ids: &[GaussPointId], s: Status) -> Status {
+        oversized(call, &self.sizes(ids), self.max_message, self.info.max_message_bytes, s)
+    }
+
     /// (assemblies, discs, relaxations in flight).
     pub async fn health(&self, timeout: Duration) -> Result<(u64, u64, u64), Status> {
         let mut c = self.client.clone();
@@ -243,7 +313,13 @@ impl Link {
         };
         let r =
             bounded(timeout, c.create_assemblies(with_timeout(req, timeout))).await?.into_inner();
-        r.assemblies.into_iter().map(|a| a.try_into().map_err(bad_reply)).collect()
+        let infos: Vec<AssemblyInfo> = r
+            .assemblies
+            .into_iter()
+            .map(|a| a.try_into().map_err(bad_reply))
+            .collect::<Result<_, _>>()?;
+        self.record(infos.iter().map(|i| (i.id, i.disc_count)));
+        Ok(infos)
     }
 
     /// Solves a batch, collecting the streamed results; a stream that ends before every
@@ -274,7 +350,9 @@ impl Link {
             let mut stream = c.solve_batch(with_timeout(req, timeout)).await?.into_inner();
             let mut out = Vec::with_capacity(n);
             while let Some(r) = stream.message().await? {
-                out.push(from_proto::solve_result(r).map_err(bad_reply)?);
+                let (id, outcome) = from_proto::solve_result(r).map_err(bad_reply)?;
+                // A failed relaxation's reason is the worker's text: made printable too.
+                out.push((id, outcome.map_err(|e| cosdem_proto::printable(&e))));
             }
             if out.len() != n {
                 return Err(Status::unavailable(format!(
@@ -288,7 +366,9 @@ impl Link {
     }
 
     /// Commits trial (step, iteration) of `ids`, returning their new committed states if
-    /// `export` (else none).
+    /// `export` (else none). States that would not fit one reply within the message limit
+    /// are exported after the commit, in as many ExportState calls as they need (the same
+    /// bytes: nothing runs on them in between).
     pub async fn commit(
         &self,
         ids: &[GaussPointId],
@@ -297,15 +377,33 @@ impl Link {
         export: bool,
         timeout: Duration,
     ) -> Result<Vec<AssemblyState>, Status> {
+        let total = ids.iter().fold(0u64, |a, id| a.saturating_add(self.state_size(id)));
+        let split = export && !ids.is_empty() && total > self.limit();
         let mut c = self.client.clone();
         let req = pb::CommitRequest {
             step,
             iteration,
             ids: ids.iter().map(|i| (*i).into()).collect(),
-            export_state: export,
+            export_state: export && !split,
         };
-        let r = bounded(timeout, c.commit(with_timeout(req, timeout))).await?.into_inner();
-        r.states.into_iter().map(|s| s.try_into().map_err(bad_reply)).collect()
+        let r = bounded(timeout, c.commit(with_timeout(req, timeout)))
+            .await
+            .map_err(|s| self.sized("Commit (exporting)", ids, s))?
+            .into_inner();
+        if split {
+            return self.export(ids, timeout).await;
+        }
+        self.states(r.states)
+    }
+
+    /// Decoded states, their disc counts remembered.
+    fn states(&self, states: Vec<pb::AssemblyState>) -> Result<Vec<AssemblyState>, Status> {
+        let states: Vec<AssemblyState> = states
+            .into_iter()
+            .map(|s| s.try_into().map_err(bad_reply))
+            .collect::<Result<_, _>>()?;
+        self.record(states.iter().map(|s| (s.id, s.disc_count)));
+        Ok(states)
     }
 
     /// Discards trial states of `ids`.
@@ -316,27 +414,51 @@ impl Link {
         Ok(())
     }
 
-    /// Committed states of `ids`.
+    /// Committed states of `ids` (all for an empty list), in as many ExportState calls as
+    /// the message limit needs (each bounded by `timeout`), by the states' sizes bounded from
+    /// their disc counts ([`cosdem_dem::spec::state_bytes`]).
     pub async fn export(
         &self,
         ids: &[GaussPointId],
         timeout: Duration,
     ) -> Result<Vec<AssemblyState>, Status> {
-        let mut c = self.client.clone();
-        let req = pb::ExportStateRequest { ids: ids.iter().map(|i| (*i).into()).collect() };
-        let r = bounded(timeout, c.export_state(with_timeout(req, timeout))).await?.into_inner();
-        r.states.into_iter().map(|s| s.try_into().map_err(bad_reply)).collect()
+        let parts = if ids.is_empty() {
+            vec![Vec::new()]
+        } else {
+            groups(ids.to_vec(), |id| self.state_size(id), self.limit())
+        };
+        let mut out = Vec::with_capacity(ids.len());
+        for part in parts {
+            let mut c = self.client.clone();
+            let req = pb::ExportStateRequest { ids: part.iter().map(|i| (*i).into()).collect() };
+            let r = bounded(timeout, c.export_state(with_timeout(req, timeout)))
+                .await
+                .map_err(|s| self.sized("ExportState", &part, s))?
+                .into_inner();
+            out.extend(self.states(r.states)?);
+        }
+        Ok(out)
     }
 
-    /// Creates or replaces assemblies from committed states.
+    /// Creates or replaces assemblies from committed states, in as many ImportState calls as
+    /// the message limit needs (each bounded by `timeout`).
     pub async fn import(
         &self,
         states: Vec<AssemblyState>,
         timeout: Duration,
     ) -> Result<(), Status> {
-        let mut c = self.client.clone();
-        let req = pb::ImportStateRequest { states: states.into_iter().map(Into::into).collect() };
-        bounded(timeout, c.import_state(with_timeout(req, timeout))).await?;
+        let size = |s: &AssemblyState| {
+            (s.state.len() as u64).saturating_add(cosdem_dem::spec::STATE_ENVELOPE_BYTES)
+        };
+        for part in groups(states, size, self.limit()) {
+            let ids: Vec<GaussPointId> = part.iter().map(|s| s.id).collect();
+            self.record(part.iter().map(|s| (s.id, s.disc_count)));
+            let mut c = self.client.clone();
+            let req = pb::ImportStateRequest { states: part.into_iter().map(Into::into).collect() };
+            bounded(timeout, c.import_state(with_timeout(req, timeout)))
+                .await
+                .map_err(|s| self.sized("ImportState", &ids, s))?;
+        }
         Ok(())
     }
 
@@ -349,6 +471,14 @@ impl Link {
         let mut c = self.client.clone();
         let req = pb::DropRequest { ids: ids.iter().map(|i| (*i).into()).collect() };
         bounded(timeout, c.drop(with_timeout(req, timeout))).await?;
+        let mut d = self.lock_discs();
+        if ids.is_empty() {
+            d.clear();
+        } else {
+            ids.iter().for_each(|id| {
+                d.remove(id);
+            });
+        }
         Ok(())
     }
 
@@ -360,7 +490,10 @@ impl Link {
     ) -> Result<cosdem_common::micro::MicroSnapshot, Status> {
         let mut c = self.client.clone();
         let req = pb::SnapshotRequest { id: Some(id.into()) };
-        let r = bounded(timeout, c.snapshot(with_timeout(req, timeout))).await?.into_inner();
+        let r = bounded(timeout, c.snapshot(with_timeout(req, timeout)))
+            .await
+            .map_err(|s| self.sized("Snapshot", &[id], s))?
+            .into_inner();
         Ok(r.into())
     }
 }

@@ -2,6 +2,7 @@
 //! address, or in-process ones), the admission of returned or new workers at load steps, and
 //! the placement of new assemblies by expected cost ([`balance`](crate::balance)).
 
+use crate::address::{check_address, resolve, resolve_all};
 use crate::balance::{Cost, effective_costs, place};
 use crate::fanout::{Job, fan_out};
 use crate::link::{self, Link, WorkerInfo};
@@ -38,41 +39,39 @@ pub(crate) fn refused(worker: &str, s: &Status) -> PoolError {
     PoolError::Refused { worker: worker.into(), code: s.code(), message: s.message().into() }
 }
 
-/// The addresses `source` resolves to, within `timeout` (a name whose DNS server does not
-/// answer must not stall the run: the lookup itself goes on in a blocking thread, abandoned).
-async fn resolve(source: &str, timeout: Duration) -> Vec<SocketAddr> {
-    match tokio::time::timeout(timeout, tokio::net::lookup_host(source)).await {
-        Ok(Ok(addrs)) => {
-            let mut v: Vec<_> = addrs.collect();
-            v.sort();
-            v.dedup();
-            v
-        }
-        Ok(Err(e)) => {
-            tracing::warn!(source, error = %e, "cannot resolve worker address");
-            Vec::new()
-        }
-        Err(_) => {
-            tracing::warn!(source, ?timeout, "worker address not resolved in time");
-            Vec::new()
-        }
-    }
+/// Ids per CreateAssemblies request to a worker of `memory` bytes (0: unknown) for
+/// assemblies of `discs` discs each: within the worker's per-request caps
+/// ([`Limits::MAX_IDS_PER_REQUEST`], [`Limits::request_disc_cap`]), at least one.
+fn request_size(discs: u64, memory: u64) -> usize {
+    let by_discs = Limits::request_disc_cap((memory > 0).then_some(memory)) / discs.max(1);
+    (by_discs.min(Limits::MAX_IDS_PER_REQUEST as u64) as usize).max(1)
 }
 
-/// Resolves every source concurrently, each within `timeout`; sorted, without duplicates.
-async fn resolve_all(sources: &[String], timeout: Duration) -> Vec<SocketAddr> {
-    let mut set = tokio::task::JoinSet::new();
-    for s in sources {
-        let s = s.clone();
-        set.spawn(async move { resolve(&s, timeout).await });
+/// A CreateAssemblies past its deadline, naming the setting and its value.
+fn create_deadline_named(
+    s: Status,
+    ids: usize,
+    discs: u64,
+    deadline: Duration,
+    scaled: bool,
+) -> Status {
+    if s.code() != Code::DeadlineExceeded {
+        return s;
     }
-    let mut out = Vec::new();
-    while let Some(r) = set.join_next().await {
-        out.extend(r.unwrap_or_default());
-    }
-    out.sort();
-    out.dedup();
-    out
+    let how = if scaled {
+        format!(
+            "create_timeout unset: call_timeout plus {:e} s x discs^1.5 for {discs} discs \
+             (PoolConfig::create_deadline)",
+            crate::config::CREATE_SECONDS_PER_DISC_POW
+        )
+    } else {
+        "create_timeout".into()
+    };
+    Status::deadline_exceeded(format!(
+        "CreateAssemblies of {ids} assemblies of about {discs} discs: {}; the deadline is \
+         {deadline:?} ({how}; set PoolConfig::create_timeout for more)",
+        s.message()
+    ))
 }
 
 /// Tries the addresses in `candidates` concurrently: those that answer the handshake, report
@@ -102,13 +101,26 @@ async fn try_admit(candidates: Vec<SocketAddr>, config: PoolConfig) -> Vec<(Sock
     out
 }
 
+/// A status by which a cosdem worker refuses this master on purpose (wrong or missing token,
+/// another protocol version): a configuration to fix, so an error, not a worker to skip.
+fn is_refusal(s: &Status) -> bool {
+    matches!(s.code(), Code::Unauthenticated | Code::PermissionDenied | Code::FailedPrecondition)
+}
+
 impl Pool {
     /// Connects to workers given as `host:port` (each name may resolve to several addresses,
-    /// one worker each) and shakes hands with each. Unreachable addresses are skipped with a
-    /// warning; a refusal (token, protocol version) is an error; no worker at all is an error.
+    /// one worker each) and shakes hands with each. An address of no such form is an error
+    /// naming it. Unreachable addresses are skipped with a warning, and so are endpoints whose
+    /// handshake fails (not a cosdem worker: an HTTP server, garbage), naming the address and
+    /// the reason; a refusal by a worker (token, protocol version, either side's check) is an
+    /// error. With no worker left: the first failed handshake as the error, else "none
+    /// answered".
     pub fn connect(addresses: &[String], config: PoolConfig) -> Result<Pool, PoolError> {
         if addresses.is_empty() {
             return Err(PoolError::Config("no worker addresses given".into()));
+        }
+        for a in addresses {
+            check_address(a)?;
         }
         config.validate()?;
         let rt = runtime(config.runtime_threads)?;
@@ -133,6 +145,7 @@ impl Pool {
                     "worker {a} is not on loopback: a token is required (COSDEM_TOKEN or --token-file)"
                 )));
             }
+            let mut failed = None;
             for addr in addrs {
                 if pool.workers.iter().any(|w| w.addr == Some(addr)) {
                     continue;
@@ -148,10 +161,20 @@ impl Pool {
                     Err(s) if matches!(s.code(), Code::Unavailable | Code::DeadlineExceeded) => {
                         tracing::warn!(%addr, error = %s.message(), "worker unreachable, skipped");
                     }
-                    Err(s) => return Err(refused(&addr.to_string(), &s)),
+                    Err(s) if is_refusal(&s) => return Err(refused(&addr.to_string(), &s)),
+                    Err(s) => {
+                        tracing::warn!(
+                            %addr, code = ?s.code(), error = %s.message(),
+                            "not a cosdem worker (its handshake failed), skipped"
+                        );
+                        failed.get_or_insert_with(|| refused(&addr.to_string(), &s));
+                    }
                 }
             }
-            Ok(())
+            match failed {
+                Some(e) if pool.workers.is_empty() => Err(e),
+                _ => Ok(()),
+            }
         })?;
         if pool.workers.is_empty() {
             return Err(PoolError::Unavailable(format!("none of {:?} answered", addresses)));
@@ -159,12 +182,25 @@ impl Pool {
         Ok(pool)
     }
 
+    /// How many in-process workers a job asking for `asked` gets: at most this machine's
+    /// cores (`std::thread::available_parallelism`), at least one. More buy nothing (results
+    /// do not depend on the worker count, so the cap changes no output), and each holds
+    /// threads of its own: `[workers] in_process = 100000` exhausted them. Logs the cap.
+    pub fn in_process_workers(asked: usize) -> usize {
+        let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
+        if asked > cores {
+            tracing::info!(asked, cores, "in-process workers capped at this machine's cores");
+        }
+        asked.clamp(1, cores)
+    }
+
     /// `n` workers inside this process, each a full MicroSolver service (request decoding,
     /// token check, limits, response encoding: the code path of the network without the
     /// network) called directly in the pool's task, or, with
     /// [`PoolConfig::in_process_duplex`], reached over an in-memory `tokio::io::duplex`
     /// HTTP/2 connection. `factory(i)` builds worker `i`'s model. What `cosdem run` uses
-    /// without `--workers`.
+    /// without `--workers`, for [`Pool::in_process_workers`] of the job's count. Each worker
+    /// runs `in_process_threads` relaxation threads, at most the machine's cores.
     pub fn in_process<M: MicroModel>(
         n: usize,
         config: PoolConfig,
@@ -177,12 +213,17 @@ impl Pool {
         let rt = runtime(config.runtime_threads)?;
         let handle = rt.handle().clone();
         let mut pool = Pool::empty(rt, handle, config);
+        // More threads per worker than cores buy nothing (results do not depend on them).
         let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
-        let threads = if pool.config.in_process_threads > 0 {
-            pool.config.in_process_threads
-        } else {
-            (cores / n).max(1)
-        };
+        let asked = pool.config.in_process_threads;
+        if asked > cores {
+            tracing::info!(
+                asked,
+                cores,
+                "in-process worker threads capped at this machine's cores"
+            );
+        }
+        let threads = if asked > 0 { asked.min(cores) } else { (cores / n).max(1) };
         for i in 0..n {
             let wc = WorkerConfig {
                 token: pool.config.token.clone(),
@@ -347,40 +388,98 @@ impl Pool {
         if let Some(id) = ids.iter().find(|id| self.owner.contains_key(id)) {
             return Err(PoolError::Config(format!("assembly for {id} already created")));
         }
-        let alive = self.alive();
-        if alive.is_empty() {
-            return Err(PoolError::Unavailable("every worker is lost".into()));
-        }
         let hint = spec.disc_count_hint.max(1);
-        let mut load = self.loads();
-        let new: Vec<_> = ids.iter().map(|id| (*id, hint as f64)).collect();
-        let mut by_worker: BTreeMap<usize, Vec<GaussPointId>> = BTreeMap::new();
-        for (id, w) in place(&new, &alive, &mut load) {
-            by_worker.entry(w).or_default().push(id);
-        }
         let t = self.config.call_timeout;
-        let jobs = by_worker
-            .into_iter()
-            .map(|(w, ids)| {
-                let link = self.workers[w].link.clone();
-                let spec = spec.clone();
-                let job: Job<_> = Box::pin(async move {
-                    let infos = link.create(&ids, &spec, t).await?;
-                    let states = link.export(&ids, t).await?;
-                    Ok((infos, states))
-                });
-                (w, job)
-            })
-            .collect();
-        for (w, r) in fan_out(jobs).await {
-            let (infos, states) = r.map_err(|s| refused(&self.workers[w].link.name, &s))?;
-            for i in infos {
-                self.owner.insert(i.id, w);
-                self.costs.insert(i.id, Cost { discs: i.disc_count, seconds: None });
+        let deadline = self.config.create_deadline(spec.disc_count_hint);
+        let scaled = self.config.create_timeout.is_none();
+        // A worker lost while creating (its CreateAssemblies or the export after it failed
+        // with a worker failure: killed, stopped past the deadline, shutting down, garbage)
+        // takes the loss path: marked lost, what it held before restored on the others
+        // (`Pool::recover`), and its share of this creation placed again on the live workers.
+        // Creation is a deterministic function of the spec and the id, so where an assembly
+        // is built changes no result.
+        let mut todo: Vec<GaussPointId> = ids.to_vec();
+        let mut rounds = crate::recovery::Rounds::default();
+        // The last worker failure, as the error once no worker is left (a CreateAssemblies
+        // past its deadline names the setting: `create_deadline_named`).
+        let mut last_loss: Option<PoolError> = None;
+        while !todo.is_empty() {
+            let alive = self.alive();
+            if alive.is_empty() {
+                return Err(last_loss
+                    .unwrap_or_else(|| PoolError::Unavailable("every worker is lost".into())));
             }
-            for s in states {
-                self.history.store(s);
+            if let Some(done) = rounds.start(self.workers.len()) {
+                return Err(PoolError::Unavailable(format!(
+                    "creation of {} assemblies still failing after {done} rounds of worker losses",
+                    todo.len()
+                )));
             }
+            let mut load = self.loads();
+            let new: Vec<_> = todo.iter().map(|id| (*id, hint as f64)).collect();
+            let mut by_worker: BTreeMap<usize, Vec<GaussPointId>> = BTreeMap::new();
+            for (id, w) in place(&new, &alive, &mut load) {
+                by_worker.entry(w).or_default().push(id);
+            }
+            let jobs = by_worker
+                .iter()
+                .map(|(w, ids)| {
+                    let link = self.workers[*w].link.clone();
+                    let spec = spec.clone();
+                    let ids = ids.clone();
+                    let per = request_size(hint, link.info.memory_bytes);
+                    let job: Job<_> = Box::pin(async move {
+                        let mut infos = Vec::with_capacity(ids.len());
+                        for part in ids.chunks(per) {
+                            let got = link.create(part, &spec, deadline).await.map_err(|s| {
+                                create_deadline_named(
+                                    s,
+                                    part.len(),
+                                    spec.disc_count_hint,
+                                    deadline,
+                                    scaled,
+                                )
+                            })?;
+                            infos.extend(got);
+                        }
+                        let states = link.export(&ids, t).await?;
+                        Ok((infos, states))
+                    });
+                    (*w, job)
+                })
+                .collect();
+            let mut lost = crate::recovery::Lost::default();
+            for (w, r) in fan_out(jobs).await {
+                match r {
+                    Err(s) if link::is_worker_failure(&s) => {
+                        let why =
+                            Status::new(s.code(), format!("{}; every worker is lost", s.message()));
+                        last_loss = Some(refused(&self.workers[w].link.name, &why));
+                        self.lose(w, &s, &mut lost);
+                    }
+                    r => {
+                        let (infos, states) =
+                            r.map_err(|s| refused(&self.workers[w].link.name, &s))?;
+                        for i in infos {
+                            self.owner.insert(i.id, w);
+                            self.costs.insert(i.id, Cost { discs: i.disc_count, seconds: None });
+                        }
+                        for s in states {
+                            self.history.store(s);
+                        }
+                    }
+                }
+            }
+            // What the lost workers were to build is built again elsewhere; what they held
+            // from earlier creations is restored from its committed history.
+            todo = lost.workers().iter().flat_map(|w| by_worker[w].iter().copied()).collect();
+            if self.alive().is_empty() {
+                return Err(last_loss
+                    .unwrap_or_else(|| PoolError::Unavailable("every worker is lost".into())));
+            }
+            self.recover(lost, crate::recovery::Redo::Nothing)
+                .await
+                .map_err(|e| PoolError::Unavailable(e.to_string()))?;
         }
         Ok(())
     }

@@ -67,6 +67,9 @@ pub(crate) enum Redo<'a> {
     /// A commit of this trial: those whose commit was not acknowledged before their worker
     /// died lost their trial with it, and are solved again at the trial before they commit.
     Commit(TrialId, &'a BTreeMap<GaussPointId, MacroDeformation>),
+    /// An export of the committed states (for a checkpoint): every lost assembly, once
+    /// restored, is exported again from its new owner.
+    Export,
 }
 
 /// Counts the rounds of one call; see the module's note on why a call ends.
@@ -139,6 +142,7 @@ impl Pool {
         self.restore(&lost).await?;
         match redo {
             Redo::Nothing => Ok(Vec::new()),
+            Redo::Export => Ok(lost),
             Redo::Solve(targets) => {
                 Ok(lost.into_iter().filter(|id| targets.contains_key(id)).collect())
             }

@@ -2,9 +2,10 @@
 //! `listen` arguments and their conversion into the service's [`WorkerConfig`] (the service
 //! library knows no clap). The test worker of `cosdem-tests` takes the same arguments.
 
-use cosdem_worker::{Limits, ServiceError, TlsIdentity, Token, WorkerConfig};
+use cosdem_worker::{Limits, ServeOptions, ServiceError, TlsIdentity, Token, WorkerConfig};
 use std::net::SocketAddr;
 use std::path::PathBuf;
+use std::time::Duration;
 
 /// `cosdem-worker listen` arguments. The binary parses them and converts with `try_into()`.
 #[derive(Clone, Debug, clap::Args)]
@@ -22,7 +23,8 @@ pub struct ListenArgs {
     /// Most assemblies held at once (0 = unlimited).
     #[arg(long, default_value_t = 0)]
     pub max_assemblies: u64,
-    /// Most discs held at once, over all assemblies (0 = unlimited).
+    /// Most discs held at once, over all assemblies (0 = as many as this machine's memory
+    /// holds, at 1 KiB a disc).
     #[arg(long, default_value_t = 0)]
     pub max_discs: u64,
     /// TLS certificate chain (PEM); with `--tls-key`, serves TLS (needs the `tls` feature).
@@ -34,6 +36,28 @@ pub struct ListenArgs {
     /// Largest gRPC message, in MiB.
     #[arg(long, default_value_t = 256)]
     pub max_message_mib: usize,
+    /// Seconds a worker asked to stop (SIGTERM, Ctrl-C) lets its calls in flight finish,
+    /// answering new ones UNAVAILABLE, before it exits anyway. Keep it below the engine's
+    /// own (10 s for `docker stop`, 30 s for Kubernetes' terminationGracePeriodSeconds).
+    #[arg(long, default_value_t = 8.0, value_name = "SECS")]
+    pub grace_period: f64,
+}
+
+impl ListenArgs {
+    /// How the worker stops: [`ServeOptions`] with `--grace-period` (no hook). A grace period
+    /// that is negative, not a number or over a day is refused, naming the option and value.
+    pub fn serve_options(&self) -> Result<ServeOptions, ServiceError> {
+        let g = self.grace_period;
+        let grace_period = Duration::try_from_secs_f64(g)
+            .ok()
+            .filter(|d| *d <= Duration::from_secs(86_400))
+            .ok_or_else(|| {
+                ServiceError::Config(format!(
+                    "--grace-period {g:?}: must be a number of seconds from 0 to 86400"
+                ))
+            })?;
+        Ok(ServeOptions { grace_period, ..ServeOptions::default() })
+    }
 }
 
 impl TryFrom<ListenArgs> for WorkerConfig {
@@ -55,5 +79,35 @@ impl TryFrom<ListenArgs> for WorkerConfig {
         };
         config.validate()?;
         Ok(config)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        listen: ListenArgs,
+    }
+
+    fn options(args: &[&str]) -> Result<ServeOptions, ServiceError> {
+        let cli = Cli::try_parse_from(std::iter::once("test").chain(args.iter().copied())).unwrap();
+        cli.listen.serve_options()
+    }
+
+    #[test]
+    fn the_grace_period_defaults_to_8_s_below_docker_s_10_and_is_checked_by_name() {
+        assert_eq!(options(&[]).unwrap().grace_period, Duration::from_secs(8));
+        assert_eq!(options(&[]).unwrap().grace_period, cosdem_worker::DEFAULT_GRACE_PERIOD);
+        let half = options(&["--grace-period", "0.5"]).unwrap();
+        assert_eq!(half.grace_period, Duration::from_millis(500));
+        assert!(half.hook.is_none());
+        for bad in ["-1", "NaN", "1e308"] {
+            let e = options(&[&format!("--grace-period={bad}")]).unwrap_err().to_string();
+            assert!(e.contains("--grace-period") && e.contains(bad), "{bad}: {e}");
+        }
     }
 }

@@ -1,7 +1,7 @@
 //! `cosdem-worker`: the DEM worker binary.
 //!
 //! ```text
-//! cosdem-worker listen [--listen ADDR] [--token-file FILE] [--threads N]
+//! cosdem-worker listen [--listen ADDR] [--token-file FILE] [--threads N] [--grace-period SECS]
 //! cosdem-worker health [--addr HOST:PORT]
 //! cosdem-worker bench dem [--quick]
 //! ```
@@ -24,7 +24,8 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Serve DEM assemblies over gRPC until SIGTERM / Ctrl-C.
+    /// Serve DEM assemblies over gRPC until SIGTERM / Ctrl-C (then drain: new calls refused,
+    /// calls in flight finished, exit within --grace-period).
     Listen(ListenArgs),
     /// Exit 0 iff the worker at `--addr` reports SERVING (for container health checks).
     Health {
@@ -113,7 +114,7 @@ fn bench_dem(quick: bool) -> Result<()> {
 }
 
 fn listen(args: ListenArgs) -> Result<()> {
-    use cosdem_worker::{Dem, WorkerConfig, serve, shutdown_signal};
+    use cosdem_worker::{Dem, WorkerConfig, bind, serve_listener_with, shutdown_signal};
     use std::io::IsTerminal;
     // The log goes to stderr, which the deploy recipes send to a file (Slurm's job output,
     // `2> worker.log`, a container's log): colour codes only when it is a terminal.
@@ -124,6 +125,7 @@ fn listen(args: ListenArgs) -> Result<()> {
         .with_writer(std::io::stderr)
         .with_ansi(std::io::stderr().is_terminal())
         .init();
+    let options = args.serve_options()?;
     let config: WorkerConfig = args.try_into()?;
     let runtime = tokio::runtime::Builder::new_multi_thread().enable_all().build()?;
     // The signal handlers are installed before the port is bound (see `shutdown_signal`).
@@ -131,7 +133,14 @@ fn listen(args: ListenArgs) -> Result<()> {
         let _guard = runtime.enter();
         shutdown_signal()
     };
-    runtime.block_on(serve(config, Dem, shutdown))?;
+    let served = runtime.block_on(async {
+        let listener = bind(&config).await?;
+        serve_listener_with(listener, config, Dem, shutdown, options).await
+    });
+    // Past the grace period calls may still run: do not wait for them (dropping the runtime
+    // would wait for its blocking tasks).
+    runtime.shutdown_background();
+    served?;
     Ok(())
 }
 

@@ -5,12 +5,17 @@ use super::auth::Token;
 use super::error::{Result, ServiceError};
 use std::net::SocketAddr;
 
-/// Limits a worker enforces (RESOURCE_EXHAUSTED beyond them; 0 = unlimited).
+/// Limits a worker enforces (RESOURCE_EXHAUSTED beyond them, naming the limit and the value;
+/// 0 = unlimited). Besides these settings, every worker refuses, before building anything, a
+/// CreateAssemblies request of more than [`Limits::MAX_IDS_PER_REQUEST`] ids or of more discs
+/// than [`Limits::request_disc_cap`] of its memory, and (with `max_discs = 0`) more discs held
+/// in all than [`Limits::memory_disc_cap`] of its memory: past those the allocator would abort the worker.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Limits {
     /// Assemblies held at once.
     pub max_assemblies: u64,
-    /// Discs summed over all assemblies held.
+    /// Discs summed over all assemblies held (0: as many as the machine's memory holds,
+    /// [`Limits::memory_disc_cap`]).
     pub max_discs: u64,
     /// Largest gRPC message in either direction (bytes). Beyond it tonic answers
     /// OUT_OF_RANGE (its code for an oversized frame), before the service sees the call.
@@ -24,6 +29,43 @@ impl Default for Limits {
             max_discs: 0,
             max_message_bytes: cosdem_proto::DEFAULT_MAX_MESSAGE_BYTES,
         }
+    }
+}
+
+impl Limits {
+    /// Most Gauss points one CreateAssemblies request may name. Fixed (not a setting), so
+    /// that a master knows it without asking: `cosdem_pool` sends a worker's share of a
+    /// creation in requests of at most this many ids. 16 384 assemblies of the default
+    /// hexagonal packing (105 discs) take about 0.4 GB; one request of 100 000 took 2.1 GB.
+    pub const MAX_IDS_PER_REQUEST: usize = 16_384;
+
+    /// Memory one disc held by a worker may take, in bytes, for the caps derived from the
+    /// machine's memory: its assembly's committed state (about 200 bytes a disc measured on
+    /// assemblies of the default packing, with the Verlet list and contact histories), a trial
+    /// state of the same size while a step is open, and the relaxation's scratch arrays. A
+    /// conservative figure: about twice what was measured.
+    pub const BYTES_PER_DISC_HELD: u64 = 1024;
+
+    /// This machine's memory in bytes (`MemTotal` of `/proc/meminfo`); `None` where unknown.
+    pub fn machine_memory() -> Option<u64> {
+        let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+        let line = text.lines().find(|l| l.starts_with("MemTotal:"))?;
+        let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+        Some(kib.saturating_mul(1024))
+    }
+
+    /// Discs a worker with `memory` bytes may hold in all when no `max_discs` is set: what
+    /// its memory holds at [`Limits::BYTES_PER_DISC_HELD`] a disc (`u64::MAX` when the memory
+    /// is unknown).
+    pub fn memory_disc_cap(memory: Option<u64>) -> u64 {
+        memory.map_or(u64::MAX, |m| (m / Self::BYTES_PER_DISC_HELD).max(1))
+    }
+
+    /// Discs one CreateAssemblies request may ask a worker with `memory` bytes to build (disc
+    /// count hint times ids): half of [`Limits::memory_disc_cap`], so that a single request
+    /// cannot take the machine (`u64::MAX` when the memory is unknown).
+    pub fn request_disc_cap(memory: Option<u64>) -> u64 {
+        memory.map_or(u64::MAX, |m| (m / 2 / Self::BYTES_PER_DISC_HELD).max(1))
     }
 }
 

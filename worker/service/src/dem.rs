@@ -22,6 +22,14 @@ impl MicroModel for Dem {
         Assembly::new(&spec).map_err(|e| ModelError::InvalidSpec(e.to_string()))
     }
 
+    /// The packing's disc count ([`AssemblySpec::disc_count_hint`]: exact for hexagonal
+    /// packings, an upper bound at worst), for a spec that reads and validates.
+    fn disc_estimate(&self, req: &AssemblyRequest) -> Option<u64> {
+        let spec: AssemblySpec = serde_json::from_slice(&req.spec_json).ok()?;
+        spec.validate().ok()?;
+        Some(spec.disc_count_hint())
+    }
+
     /// [`Assembly::new`] depends on the spec alone (a random packing's seed is in the spec),
     /// so every Gauss point of one spec holds the same specimen.
     fn replicate(&self, assembly: &Assembly, _id: GaussPointId) -> Option<Assembly> {

@@ -87,6 +87,13 @@ pub trait MicroModel: Send + Sync + 'static {
     fn replicate(&self, _assembly: &Self::Assembly, _id: GaussPointId) -> Option<Self::Assembly> {
         None
     }
+    /// The disc count an assembly of `spec` will have, read from the spec before anything is
+    /// built (an upper bound is fine), for the limits a worker checks first: the service takes
+    /// the larger of this and the master's `disc_count_hint`. `None` (the default): the hint
+    /// alone. A spec the model cannot read gives `None` (`create` then refuses it by name).
+    fn disc_estimate(&self, _spec: &AssemblyRequest) -> Option<u64> {
+        None
+    }
     /// Relative cost of one relaxation; the disc count unless the model knows better.
     fn cost_hint(&self, assembly: &Self::Assembly) -> f64 {
         self.disc_count(assembly) as f64

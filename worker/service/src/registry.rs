@@ -40,6 +40,8 @@ struct Entry<A> {
 pub struct Registry<M: MicroModel> {
     model: M,
     limits: Limits,
+    /// This machine's memory (bytes), for the caps derived from it.
+    memory: Option<u64>,
     entries: Mutex<BTreeMap<GaussPointId, Entry<M::Assembly>>>,
     in_flight: AtomicU64,
 }
@@ -55,7 +57,12 @@ pub struct SlotHandle<A>(GaussPointId, Arc<Mutex<Slot<A>>>);
 impl<M: MicroModel> Registry<M> {
     /// An empty registry.
     pub fn new(model: M, limits: Limits) -> Self {
-        Self { model, limits, entries: Mutex::default(), in_flight: AtomicU64::new(0) }
+        Self::with_memory(model, limits, Limits::machine_memory())
+    }
+
+    /// An empty registry on a machine of `memory` bytes (`None`: unknown, no cap from it).
+    pub fn with_memory(model: M, limits: Limits, memory: Option<u64>) -> Self {
+        Self { model, limits, memory, entries: Mutex::default(), in_flight: AtomicU64::new(0) }
     }
 
     /// (assemblies, discs, relaxations in flight).
@@ -65,10 +72,13 @@ impl<M: MicroModel> Registry<M> {
         (e.len() as u64, discs, self.in_flight.load(Ordering::SeqCst))
     }
 
+    /// Refuses (RESOURCE_EXHAUSTED, naming the limit and the value) to hold `new` (ids and
+    /// their disc counts, `what` says whence: hinted or built) besides what is held.
     fn check_limits(
         &self,
         entries: &BTreeMap<GaussPointId, Entry<M::Assembly>>,
         new: &[(GaussPointId, u64)],
+        what: &str,
     ) -> Result<()> {
         let added: Vec<_> = new.iter().filter(|(id, _)| !entries.contains_key(id)).collect();
         // Saturating: a hostile disc-count hint (u64::MAX) must give RESOURCE_EXHAUSTED, not
@@ -76,7 +86,8 @@ impl<M: MicroModel> Registry<M> {
         let count = (entries.len() as u64).saturating_add(added.len() as u64);
         if self.limits.max_assemblies > 0 && count > self.limits.max_assemblies {
             return Err(ServiceError::ResourceExhausted(format!(
-                "{count} assemblies would exceed this worker's limit of {}",
+                "{count} assemblies would exceed this worker's limit of {} assemblies \
+                 (max_assemblies, --max-assemblies)",
                 self.limits.max_assemblies
             )));
         }
@@ -90,8 +101,48 @@ impl<M: MicroModel> Registry<M> {
             .saturating_add(new.iter().fold(0u64, |a, (_, d)| a.saturating_add(*d)));
         if self.limits.max_discs > 0 && discs > self.limits.max_discs {
             return Err(ServiceError::ResourceExhausted(format!(
-                "{discs} discs would exceed this worker's limit of {}",
+                "{discs} discs ({held} held, {} {what} for {} assemblies) would exceed this \
+                 worker's limit of {} discs (max_discs, --max-discs)",
+                discs.saturating_sub(held.saturating_sub(replaced)),
+                new.len(),
                 self.limits.max_discs
+            )));
+        }
+        let cap = Limits::memory_disc_cap(self.memory);
+        if self.limits.max_discs == 0 && discs > cap {
+            return Err(ServiceError::ResourceExhausted(format!(
+                "{discs} discs ({held} held, {} {what} for {} assemblies) would exceed what this \
+                 worker's memory holds: {cap} discs ({} bytes at {} bytes a disc; \
+                 --max-discs sets a limit)",
+                discs.saturating_sub(held.saturating_sub(replaced)),
+                new.len(),
+                self.memory.unwrap_or(0),
+                Limits::BYTES_PER_DISC_HELD
+            )));
+        }
+        Ok(())
+    }
+
+    /// Refuses, before anything is built, a CreateAssemblies request over the per-request
+    /// caps: more than [`Limits::MAX_IDS_PER_REQUEST`] ids, or more discs (`hint` per
+    /// assembly) than [`Limits::request_disc_cap`] of this machine's memory.
+    fn check_request(&self, ids: usize, hint: u64) -> Result<()> {
+        if ids > Limits::MAX_IDS_PER_REQUEST {
+            return Err(ServiceError::ResourceExhausted(format!(
+                "{ids} ids in one CreateAssemblies request: over the limit of {} ids a request \
+                 (MAX_IDS_PER_REQUEST; send them in several requests)",
+                Limits::MAX_IDS_PER_REQUEST
+            )));
+        }
+        let discs = hint.saturating_mul(ids as u64);
+        let cap = Limits::request_disc_cap(self.memory);
+        if discs > cap {
+            return Err(ServiceError::ResourceExhausted(format!(
+                "{ids} assemblies of {hint} discs (disc_count_hint) = {discs} discs in one \
+                 CreateAssemblies request: over the limit of {cap} discs a request (half of \
+                 this worker's {} bytes of memory at {} bytes a disc)",
+                self.memory.unwrap_or(0),
+                Limits::BYTES_PER_DISC_HELD
             )));
         }
         Ok(())
@@ -103,13 +154,17 @@ impl<M: MicroModel> Registry<M> {
         ids: &[GaussPointId],
         spec: &AssemblyRequest,
     ) -> Result<Vec<AssemblyInfo>> {
+        // The disc count per assembly before anything is built: the master's hint, or the
+        // model's own reading of the spec when larger (a hint of 0 or a lie changes nothing).
+        let hint = spec.disc_count_hint.max(self.model.disc_estimate(spec).unwrap_or(0));
+        self.check_request(ids.len(), hint)?;
         {
             let entries = lock(&self.entries);
             if let Some(id) = ids.iter().find(|id| entries.contains_key(id)) {
                 return Err(ServiceError::AlreadyExists(*id));
             }
-            let hinted: Vec<_> = ids.iter().map(|id| (*id, spec.disc_count_hint)).collect();
-            self.check_limits(&entries, &hinted)?;
+            let hinted: Vec<_> = ids.iter().map(|id| (*id, hint)).collect();
+            self.check_limits(&entries, &hinted, "hinted")?;
         }
         let built = self.build(ids, spec)?;
         let mut entries = lock(&self.entries);
@@ -117,7 +172,7 @@ impl<M: MicroModel> Registry<M> {
             return Err(ServiceError::AlreadyExists(*id));
         }
         let actual: Vec<_> = built.iter().map(|(id, a)| (*id, self.model.disc_count(a))).collect();
-        self.check_limits(&entries, &actual)?;
+        self.check_limits(&entries, &actual, "built")?;
         let mut infos = Vec::with_capacity(built.len());
         for (id, a) in built {
             let info = AssemblyInfo {
@@ -169,7 +224,7 @@ impl<M: MicroModel> Registry<M> {
         let mut entries = lock(&self.entries);
         let actual: Vec<_> =
             built.iter().map(|(id, _, a)| (*id, self.model.disc_count(a))).collect();
-        self.check_limits(&entries, &actual)?;
+        self.check_limits(&entries, &actual, "imported")?;
         let mut infos = Vec::with_capacity(built.len());
         for (id, committed_step, a) in built {
             let info = AssemblyInfo {
@@ -352,6 +407,7 @@ impl<A> SlotHandle<A> {
 mod tests {
     use super::*;
     use crate::Dem;
+    use cosdem_common::micro::MicroSnapshot;
     use cosdem_dem::{Assembly, AssemblySpec, PackingSpec};
 
     fn random_spec() -> AssemblySpec {
@@ -366,6 +422,109 @@ mod tests {
             },
             ..Default::default()
         }
+    }
+
+    /// A [`Dem`] that counts the assemblies it builds: what shows that a refusal came
+    /// before building.
+    #[derive(Default)]
+    struct Counting(std::sync::atomic::AtomicUsize);
+
+    impl MicroModel for Counting {
+        type Assembly = Assembly;
+        fn create(
+            &self,
+            id: GaussPointId,
+            spec: &AssemblyRequest,
+        ) -> std::result::Result<Assembly, crate::ModelError> {
+            self.0.fetch_add(1, Ordering::SeqCst);
+            Dem.create(id, spec)
+        }
+        fn solve(
+            &self,
+            a: &mut Assembly,
+            t: &MacroDeformation,
+        ) -> std::result::Result<MicroResponse, crate::ModelError> {
+            Dem.solve(a, t)
+        }
+        fn commit(&self, a: &mut Assembly) {
+            Dem.commit(a)
+        }
+        fn rollback(&self, a: &mut Assembly) {
+            Dem.rollback(a)
+        }
+        fn export(&self, a: &Assembly) -> Vec<u8> {
+            Dem.export(a)
+        }
+        fn import(&self, b: &[u8]) -> std::result::Result<Assembly, crate::ModelError> {
+            Dem.import(b)
+        }
+        fn snapshot(&self, a: &Assembly) -> MicroSnapshot {
+            Dem.snapshot(a)
+        }
+        fn disc_count(&self, a: &Assembly) -> u64 {
+            Dem.disc_count(a)
+        }
+        fn disc_estimate(&self, spec: &AssemblyRequest) -> Option<u64> {
+            Dem.disc_estimate(spec)
+        }
+    }
+
+    fn request(spec: &AssemblySpec, hint: u64) -> AssemblyRequest {
+        AssemblyRequest {
+            spec_json: serde_json::to_vec(spec).unwrap(),
+            boundary: Default::default(),
+            disc_count_hint: hint,
+        }
+    }
+
+    /// The message of a RESOURCE_EXHAUSTED refusal (a short panic if it was accepted).
+    fn exhausted(r: Result<Vec<AssemblyInfo>>) -> String {
+        let Err(e) = r else { panic!("accepted") };
+        assert!(matches!(e, ServiceError::ResourceExhausted(_)), "{e:?}");
+        e.to_string()
+    }
+
+    /// With no hint from the master (0, what masters sent), a worker reads the disc count
+    /// from the spec and refuses over `max_discs` before building anything: two assemblies of
+    /// the default hexagonal packing (105 discs) on a worker limited to 200 discs. Without
+    /// that reading it built both (a large packing would crash it) and refused only then.
+    #[test]
+    fn the_limits_are_checked_before_building_whatever_the_hint() {
+        let limits = Limits { max_discs: 200, ..Limits::default() };
+        let reg = Registry::new(Counting::default(), limits);
+        let ids = [GaussPointId::new(0, 0), GaussPointId::new(0, 1)];
+        let e = exhausted(reg.create(&ids, &request(&AssemblySpec::default(), 0)));
+        assert!(e.contains("210 discs") && e.contains("max_discs") && e.contains("hinted"), "{e}");
+        assert_eq!(reg.model.0.load(Ordering::SeqCst), 0, "built before refusing");
+        // Within the limit: built, and the real count is still checked after.
+        reg.create(&ids[..1], &request(&AssemblySpec::default(), 0)).unwrap();
+        assert_eq!(reg.load().1, 105);
+    }
+
+    /// Per request: more than MAX_IDS_PER_REQUEST ids, or more discs than half the machine's
+    /// memory holds, are refused naming the cap, before anything is built; per worker (no
+    /// `max_discs`): more discs than the machine's memory holds. (One CreateAssemblies of
+    /// 100 000 ids took 2.1 GB; a second crashed the worker.)
+    #[test]
+    fn requests_and_workers_are_capped_before_building() {
+        let spec = AssemblySpec::default();
+        let reg = Registry::new(Counting::default(), Limits::default());
+        let many: Vec<_> =
+            (0..=Limits::MAX_IDS_PER_REQUEST as u32).map(|e| GaussPointId::new(e, 0)).collect();
+        let e = exhausted(reg.create(&many, &request(&spec, 105)));
+        assert!(e.contains("16385 ids") && e.contains("MAX_IDS_PER_REQUEST"), "{e}");
+        // A machine of 1 MiB: 1024 discs in all, 512 a request.
+        let reg = Registry::with_memory(Counting::default(), Limits::default(), Some(1 << 20));
+        let e = exhausted(reg.create(&many[..5], &request(&spec, 105)));
+        assert!(e.contains("525 discs") && e.contains("disc_count_hint"), "{e}");
+        assert!(e.contains("limit of 512 discs a request"), "{e}");
+        for k in 0..9 {
+            reg.create(&many[k..k + 1], &request(&spec, 105)).unwrap();
+        }
+        let e = exhausted(reg.create(&many[9..10], &request(&spec, 105)));
+        assert!(e.contains("1050 discs") && e.contains("memory holds: 1024 discs"), "{e}");
+        assert!(e.contains("--max-discs"), "{e}");
+        assert_eq!(reg.model.0.load(Ordering::SeqCst), 9, "built before refusing");
     }
 
     /// One spec for several Gauss points builds one random specimen and copies it: every

@@ -38,6 +38,13 @@ impl<M: MicroModel> WorkerService<M> {
             config,
         })
     }
+
+    /// How many relaxations run now (a probe that outlives the service): a SolveBatch call
+    /// answers with a stream at once, its relaxations go on after it. What a drain waits for.
+    pub(crate) fn relaxing(&self) -> impl Fn() -> u64 + Send + Sync + 'static {
+        let registry = self.registry.clone();
+        move || registry.load().2
+    }
 }
 
 /// Runs blocking work off the async runtime. Not on the relaxation pool: commit, export and
@@ -89,7 +96,7 @@ impl<M: MicroModel> MicroSolver for WorkerService<M> {
             }
             .into());
         }
-        tracing::info!(master = %req.master_build_id, "handshake");
+        tracing::info!(master = %cosdem_proto::printable(&req.master_build_id), "handshake");
         let l = self.config.limits;
         Ok(Response::new(pb::HandshakeReply {
             protocol_version: PROTOCOL_VERSION,
