@@ -80,7 +80,7 @@ pub struct Checkpoint {
 }
 
 fn bad(path: &Path, message: String) -> Error {
-    Error::JobFile { file: path.display().to_string(), message }
+    Error::Checkpoint { file: path.display().to_string(), message }
 }
 
 impl Checkpoint {
@@ -103,7 +103,17 @@ impl Checkpoint {
                 state: s.state,
             })
             .collect();
-        Ok(Self { digests, solver: solver.state(), assemblies })
+        let mut solver = solver.state();
+        // The solves' wall times are the one thing in the state that is not a function of the
+        // job: zeroed, so that the checkpoint of a resumed or failed-over run is byte for byte
+        // the uninterrupted run's.
+        for r in solver.committed.iter_mut().flatten() {
+            r.diagnostics.wall_seconds = 0.0;
+        }
+        for g in &mut solver.gauss_points {
+            g.diagnostics.wall_seconds = 0.0;
+        }
+        Ok(Self { digests, solver, assemblies })
     }
 
     /// The material's committed states, for [`Material::restore_states`].
@@ -134,7 +144,15 @@ impl Checkpoint {
     /// an older format (by name), one that is not a checkpoint, and one whose checksum does
     /// not match (damaged).
     pub fn read(path: &Path) -> Result<Self> {
-        let bytes = std::fs::read(path).map_err(|e| bad(path, e.to_string()))?;
+        let bytes = std::fs::read(path).map_err(|e| match e.kind() {
+            std::io::ErrorKind::NotFound => bad(
+                path,
+                "not found: the run stopped before its first checkpoint, or this is not its \
+                 directory; start again with --overwrite"
+                    .into(),
+            ),
+            _ => bad(path, e.to_string()),
+        })?;
         let head = &bytes[..MAGIC.len().min(bytes.len())];
         if let Some(old) = OLD_MAGICS.iter().find(|o| head == o.as_slice()) {
             return Err(bad(

@@ -47,6 +47,7 @@ fn sigterm_stops_after_the_step_and_resume_finishes() {
     let bin = env!("CARGO_BIN_EXE_cosdem");
     let mut child = Command::new(bin)
         .args(["run", job.to_str().unwrap(), "--quiet", "--out", out.to_str().unwrap()])
+        .stderr(std::process::Stdio::piped())
         .spawn()
         .unwrap();
     // Wait for a few finished steps: the handler is installed before the first one.
@@ -58,10 +59,18 @@ fn sigterm_stops_after_the_step_and_resume_finishes() {
     }
     let pid = child.id().to_string();
     assert!(Command::new("kill").args(["-TERM", &pid]).status().unwrap().success());
-    let status = child.wait().unwrap();
+    let ended = child.wait_with_output().unwrap();
+    let status = ended.status;
     assert_eq!(status.code(), Some(1), "interrupted runs exit with 1: {status:?}");
     let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
-    assert!(summary.contains("\"interrupted\""), "{summary}");
+    assert!(
+        summary.contains("\"interrupted: stopped by Ctrl-C or SIGTERM after step"),
+        "{summary}"
+    );
+    // The hint gives the command that goes on: the same job and --out.
+    let stderr = String::from_utf8_lossy(&ended.stderr);
+    let hint = format!("cosdem run {} --out {} --resume", job.display(), out.display());
+    assert!(stderr.contains(&hint), "{stderr}");
     assert!(out.join("checkpoint.bin").is_file());
     let done = rows(&out);
     assert!((3..400).contains(&done), "{done} steps");

@@ -157,8 +157,7 @@ pub fn ended_run(
     if recorded != serde_json::to_string_pretty(job).ok()? {
         return None;
     }
-    let text = std::fs::read_to_string(dir.join("summary.json")).ok()?;
-    let summary: cosdem_app::output::run_dir::Summary = serde_json::from_str(&text).ok()?;
+    let summary = cosdem_app::output::run_dir::Summary::read(dir).ok()?;
     let ended = summary.status == "finished" || summary.status.starts_with("failed");
     let curve = cosdem_app::output::plot::curve::read_curve(&dir.join("curve.csv")).ok()?;
     (ended && curve.len() as u64 == summary.steps).then_some((summary, curve))
@@ -181,11 +180,16 @@ fn run_variant(
             ended
         }
         None => {
-            std::fs::create_dir_all(&dir)
-                .map_err(cosdem_app::output::io_err(&dir, "create directory"))?;
+            // A run of the variant that is there did not end (or is another job's): it is kept
+            // as `<slug>.old-N` and the variant runs again. The variant file is written once
+            // the run has ended, so that only an ended run is ever reused.
+            let outcome =
+                cosdem_app::run::Run::new(&v.job, &dir).workers(workers.clone()).overwrite(true);
+            let outcome = outcome.execute()?;
             let json = serde_json::to_string_pretty(&v.job)?;
             cosdem_app::output::write_atomic(&dir.join(VARIANT_FILE), json.as_bytes())?;
-            cosdem_app::run::run_job(&v.job, &dir, workers)?
+            let summary = outcome.summary.expect("a run with a directory has a summary");
+            (summary, outcome.curve)
         }
     };
     let (rm, rc, rt) =

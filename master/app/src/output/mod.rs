@@ -8,6 +8,8 @@
 //! Numbers are printed by [`fmt_f64`](crate::output::fmt_f64): the shortest text that parses
 //! back to the same `f64`.
 
+/// Claiming a run directory: lock, empty-or-overwrite, `RUN.old-N`, temporary files.
+pub mod claim;
 /// CSV curves (load-displacement), one flushed row per converged step.
 pub mod csv;
 /// The equivalent-strain field of chosen steps as JSON, for the Fig. 9 plot.
@@ -16,6 +18,8 @@ pub mod field_data;
 pub mod plot;
 /// ParaView `.pvd` collections: the time series of `.vtu` files.
 pub mod pvd;
+/// A run directory cut back to its checkpoint's step on a resume.
+pub mod restart;
 /// The run directory written as the run goes: curve, VTK series, summary.
 pub mod run_dir;
 /// Particle snapshots of chosen Gauss points: fetched after each commit, VTK out and back.

@@ -14,7 +14,7 @@
 use super::csv::CsvWriter;
 use super::pvd::PvdWriter;
 use super::snapshots::{SnapshotInbox, SnapshotTap};
-use super::visuals::{StepInfo, VisualOutputs};
+use super::visuals::{StepInfo, VisualOutputs, reached as done};
 use super::vtk::{gauss_point_piece, nodal_piece, write_vtu};
 use super::{OutputError, Result, write_atomic};
 use cosdem_common::Answer;
@@ -65,7 +65,10 @@ pub struct RunSettings {
 pub struct Summary {
     /// The job's title.
     pub title: String,
-    /// `running`, `finished` or `failed: <reason>`.
+    /// `running`, `finished`, `stopped` (at `--max-steps`), `failed: <reason>` or
+    /// `interrupted: <reason>`. Read with [`Summary::read`], a `running` left by a process
+    /// that ended without writing its status (killed: the directory's lock is free) reads as
+    /// `interrupted: ...`.
     pub status: String,
     /// Converged steps so far.
     pub steps: u64,
@@ -99,6 +102,23 @@ pub struct Summary {
     pub wall_seconds: f64,
     /// Workers used (set by the caller).
     pub workers: usize,
+}
+
+impl Summary {
+    /// The summary of the run directory `dir`, with the status it has now: a `running` whose
+    /// writer no longer holds the directory's lock ([`super::claim::is_locked`]) is
+    /// `interrupted: the process writing the run ended without a status (killed?)`.
+    pub fn read(dir: &Path) -> Result<Self> {
+        let path = dir.join("summary.json");
+        let text = std::fs::read_to_string(&path).map_err(super::io_err(&path, "read"))?;
+        let mut s: Self = serde_json::from_str(&text)
+            .map_err(|e| OutputError::InvalidData { path: path.clone(), message: e.to_string() })?;
+        if s.status == "running" && !super::claim::is_locked(dir) {
+            s.status =
+                "interrupted: the process writing the run ended without a status (killed?)".into();
+        }
+        Ok(s)
+    }
 }
 
 /// Writes the run directory; a [`StepObserver`].
@@ -186,14 +206,15 @@ impl RunWriter {
         write_atomic(&path, kept.as_bytes())?;
         let csv = CsvWriter::resume(&path, &CURVE_COLUMNS)?;
         let displacement = rows.last().map_or(0.0, |r| r[2]);
+        let displacements: Vec<f64> = rows.iter().map(|r| r[2]).collect();
+        super::restart::cut_back(dir, step, &displacements, settings.vtk_every > 0)?;
         let (fields, gauss) = if settings.vtk_every > 0 {
             std::fs::create_dir_all(dir.join("vtk"))
                 .map_err(super::io_err(dir, "create vtk/ in"))?;
-            let mut f = PvdWriter::resume(&dir.join("fields.pvd"))?;
-            let mut g = PvdWriter::resume(&dir.join("gauss.pvd"))?;
-            f.truncate_after(displacement)?;
-            g.truncate_after(displacement)?;
-            (Some(f), Some(g))
+            (
+                Some(PvdWriter::resume(&dir.join("fields.pvd"))?),
+                Some(PvdWriter::resume(&dir.join("gauss.pvd"))?),
+            )
         } else {
             (None, None)
         };
@@ -263,10 +284,10 @@ impl RunWriter {
         Ok(w)
     }
 
-    /// Marks the run interrupted (stopped cleanly; resume with `--resume`) and writes the
-    /// summary.
-    pub fn finish_interrupted(&mut self) -> Result<()> {
-        self.summary.status = "interrupted".into();
+    /// Marks the run interrupted (stopped cleanly; resume with `--resume`) for `reason` and
+    /// writes the summary.
+    pub fn finish_interrupted(&mut self, reason: &str) -> Result<()> {
+        self.summary.status = format!("interrupted: {reason}");
         self.write_summary()
     }
 
@@ -303,7 +324,12 @@ impl RunWriter {
         field_plots_at: &[f64],
     ) -> SnapshotTap<'m> {
         let inbox = SnapshotInbox::default();
-        self.visuals = VisualOutputs::new(snapshots.clone(), field_plots_at, inbox.clone());
+        // On a resume the displacements reached before the checkpoint have had their field
+        // data and snapshots.
+        let reached = if self.summary.steps > 0 { self.summary.displacement } else { f64::MIN };
+        let pending: Vec<f64> =
+            field_plots_at.iter().copied().filter(|&d| !done(reached, d)).collect();
+        self.visuals = VisualOutputs::new(snapshots.clone(), &pending, inbox.clone());
         SnapshotTap::new(material, snapshots, inbox)
     }
 

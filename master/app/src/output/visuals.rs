@@ -44,6 +44,11 @@ pub struct StepInfo {
     pub internal_length: f64,
 }
 
+/// Whether a step at `displacement` reaches the field-plot displacement `at` (to 1e-9 of it).
+pub fn reached(displacement: f64, at: f64) -> bool {
+    displacement >= at - (1e-9 * at.abs() + 1e-15)
+}
+
 /// File stem of a Gauss point's snapshot series.
 pub fn series_name(id: GaussPointId) -> String {
     format!("e{}_p{}", id.element, id.point)
@@ -63,19 +68,19 @@ impl VisualOutputs {
 
     /// Writes what the step calls for into `dir`.
     pub fn on_step(&mut self, dir: &Path, s: StepInfo, view: &SolutionView<'_>) -> Result<()> {
-        let mut reached = false;
+        let mut hit = false;
         while let Some(&d) = self.pending.first() {
-            if s.displacement >= d - (1e-9 * d.abs() + 1e-15) {
-                reached = true;
+            if reached(s.displacement, d) {
+                hit = true;
                 self.pending.remove(0);
             } else {
                 break;
             }
         }
-        if reached || s.last {
+        if hit || s.last {
             self.write_field(dir, s, view)?;
         }
-        if reached || s.last || s.on_cadence {
+        if hit || s.last || s.on_cadence {
             for i in 0..self.snapshot_ids.len() {
                 let id = self.snapshot_ids[i];
                 if let Some(snap) = self.inbox.take(id, s.step) {
@@ -133,7 +138,9 @@ impl VisualOutputs {
             std::collections::btree_map::Entry::Occupied(e) => e.into_mut(),
             std::collections::btree_map::Entry::Vacant(e) => {
                 std::fs::create_dir_all(&sub).map_err(io_err(&sub, "create directory"))?;
-                e.insert(PvdWriter::create(&dir.join("snapshots").join(format!("{name}.pvd")))?)
+                // A resumed run goes on with the series its directory holds (rebuilt by
+                // `super::restart::cut_back`); a new run's directory has none.
+                e.insert(PvdWriter::resume(&dir.join("snapshots").join(format!("{name}.pvd")))?)
             }
         };
         write_vtu(&path, &snapshot_piece(&particles))?;

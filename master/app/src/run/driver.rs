@@ -11,12 +11,13 @@
 use super::observer::{RunObserver, Silent, StepHook};
 use super::{RunError, WorkerChoice, gauss_point_ids, material_for, run_settings, tuned};
 use crate::checkpoint::{self, Checkpoint, Checkpointer};
+use crate::output::claim::{Claim, Mode};
 use crate::output::run_dir::{RunWriter, Summary};
 use crate::output::snapshots::resolve_snapshot_ids;
 use cosdem_common::GaussPointId;
 use cosdem_fem::material::Material;
 use cosdem_fem::solve::Solver;
-use cosdem_job::Job;
+use cosdem_job::{Job, admission};
 use std::path::Path;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
@@ -84,6 +85,8 @@ pub struct Run<'a> {
     workers: WorkerChoice,
     material: Option<BuildMaterial<'a>>,
     resume: Option<bool>,
+    overwrite: bool,
+    max_memory: Option<u64>,
     checkpoints: bool,
     snapshots: bool,
     max_steps: Option<u64>,
@@ -106,6 +109,8 @@ impl<'a> Run<'a> {
             workers: WorkerChoice::default(),
             material: None,
             resume: None,
+            overwrite: false,
+            max_memory: None,
             checkpoints: false,
             snapshots: false,
             max_steps: None,
@@ -137,6 +142,22 @@ impl<'a> Run<'a> {
     pub fn resume(mut self, newton_changed: bool) -> Self {
         self.resume = Some(newton_changed);
         self.checkpoints = true;
+        self
+    }
+
+    /// A new run into a directory that holds a previous run: once the setup has succeeded the
+    /// old directory is renamed `RUN.old-N` and the run starts in a fresh one (without it, such
+    /// a directory is refused: [`crate::output::claim::ClaimError::NotEmpty`]).
+    pub fn overwrite(mut self, on: bool) -> Self {
+        self.overwrite = on;
+        self
+    }
+
+    /// Refuses, before anything is allocated, a job whose estimated memory in this process
+    /// exceeds `bytes` ([`cosdem_job::admission`]); default: 80 % of the machine's memory
+    /// ([`cosdem_job::admission::default_memory_limit`]). `u64::MAX`: no limit.
+    pub fn max_memory(mut self, bytes: Option<u64>) -> Self {
+        self.max_memory = bytes;
         self
     }
 
@@ -190,8 +211,19 @@ impl<'a> Run<'a> {
     /// first step (the job, the checkpoint, the material, the run directory) and failures to
     /// write the summary are `Err`.
     pub fn execute(self) -> Result<RunOutcome, RunError> {
-        let Run { dir, workers, material, resume, checkpoints, snapshots, max_steps, stop, .. } =
-            self;
+        let Run {
+            dir,
+            workers,
+            material,
+            resume,
+            overwrite,
+            max_memory,
+            checkpoints,
+            snapshots,
+            max_steps,
+            stop,
+            ..
+        } = self;
         let mut silent = Silent;
         let observer: &mut dyn RunObserver = match self.observer {
             Some(o) => o,
@@ -204,15 +236,26 @@ impl<'a> Run<'a> {
         // of the job, so a resume picks the same ones).
         let (job, report) = tuned(self.job)?;
         let job = &job;
-        if let Some(dir) = dir {
-            std::fs::create_dir_all(dir)
-                .map_err(|source| RunError::CreateDir { path: dir.to_path_buf(), source })?;
-            observer.on_dir(dir).map_err(RunError::Observer)?;
+        // Admission: a job too large for this machine is refused before anything is built.
+        let in_process = material.is_some() || workers.addresses.is_empty();
+        let limit = max_memory.or_else(admission::default_memory_limit);
+        for line in super::admit(job, limit, in_process, workers.config.max_message_bytes)? {
+            observer.on_plan_line(&line);
         }
-        if let Some(report) = &report {
-            if let Some(dir) = dir {
-                super::write_accuracy_report(report, dir)?;
+        // The directory is claimed (locked; a new run refused in a directory that holds
+        // one) before anything is built, and committed once the setup has succeeded.
+        let claim = match dir {
+            Some(dir) => {
+                let mode = match (resume.is_some(), overwrite) {
+                    (true, _) => Mode::Resume,
+                    (false, true) => Mode::Overwrite,
+                    (false, false) => Mode::Fresh,
+                };
+                Some(Claim::take(dir, mode)?)
             }
+            None => None,
+        };
+        if let Some(report) = &report {
             for line in report.lines() {
                 observer.on_plan_line(&line);
                 tracing::info!("{line}");
@@ -254,6 +297,18 @@ impl<'a> Run<'a> {
                 (m, 0)
             }
         };
+        // The setup has succeeded: the run directory is the run's from here on.
+        let _lock = match (claim, dir) {
+            (Some(claim), Some(dir)) => {
+                let lock = claim.commit()?;
+                observer.on_dir(dir).map_err(RunError::Observer)?;
+                if let Some(report) = &report {
+                    super::write_accuracy_report(report, dir)?;
+                }
+                Some(lock)
+            }
+            _ => None,
+        };
         let mut writer = match (dir, &checkpoint) {
             (Some(dir), Some(c)) => Some(RunWriter::resume(dir, run_settings(job), c.solver.step)?),
             (Some(dir), None) => Some(RunWriter::create(dir, run_settings(job))?),
@@ -265,10 +320,13 @@ impl<'a> Run<'a> {
         if let Some(c) = checkpoint {
             solver.restore(c.solver)?;
         }
-        let stop = match stop {
-            Stop::Never => Arc::new(AtomicBool::new(false)),
-            Stop::Flag(flag) => flag,
-            Stop::Signals => checkpoint::ctrl_c_flag().map_err(RunError::Signals)?,
+        let (stop, stopped_by) = match stop {
+            Stop::Never => (Arc::new(AtomicBool::new(false)), ""),
+            Stop::Flag(flag) => (flag, "stop requested"),
+            Stop::Signals => (
+                checkpoint::ctrl_c_flag().map_err(RunError::Signals)?,
+                "stopped by Ctrl-C or SIGTERM",
+            ),
         };
         let mut tap;
         let material: &mut dyn Material = match writer.as_mut() {
@@ -313,7 +371,10 @@ impl<'a> Run<'a> {
             match &ending {
                 Ending::Finished => w.finish(Ok(()))?,
                 Ending::Failed(e) => w.finish(Err(e.to_string()))?,
-                Ending::Interrupted => w.finish_interrupted()?,
+                Ending::Interrupted => w.finish_interrupted(&format!(
+                    "{stopped_by} after step {}; the checkpoint is written, go on with --resume",
+                    solver.step()
+                ))?,
                 Ending::Stopped => w.finish_stopped()?,
             }
         }

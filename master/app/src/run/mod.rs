@@ -43,14 +43,24 @@ pub enum RunError {
     /// The accuracy target could not be turned into settings.
     #[error(transparent)]
     Accuracy(#[from] cosdem_tune::accuracy::AccuracyError),
-    /// The run directory could not be created.
-    #[error("creating {}", path.display())]
-    CreateDir {
-        /// The directory.
-        path: std::path::PathBuf,
-        /// Why.
-        #[source]
-        source: std::io::Error,
+    /// The run directory could not be claimed: another run writes it, it holds a previous
+    /// run (and neither `--overwrite` nor `--resume` was given), or it is missing on a resume.
+    #[error(transparent)]
+    Claim(#[from] crate::output::claim::ClaimError),
+    /// The job is too large for the memory limit (`--max-memory`).
+    #[error("{0}; the limit is `cosdem run --max-memory` (default: 80 % of this machine's memory)")]
+    Admission(#[from] cosdem_job::admission::AdmissionError),
+    /// One assembly's state would not fit in a message between master and worker.
+    #[error(
+        "one assembly of material.assembly.packing holds about {discs} discs, whose state takes up to {bytes} bytes: more than the message limit of {limit} bytes (PoolConfig::max_message_bytes, the worker's --max-message-mib); use smaller assemblies (packing.side) or raise both limits"
+    )]
+    StateTooLarge {
+        /// Discs per assembly (the spec's hint).
+        discs: u64,
+        /// Bound of one state's encoded size.
+        bytes: u64,
+        /// The message limit.
+        limit: usize,
     },
     /// The Ctrl-C / SIGTERM handler could not be installed.
     #[error("installing the Ctrl-C handler")]
@@ -70,6 +80,48 @@ pub fn tuned(job: &Job) -> Result<(Job, Option<cosdem_tune::accuracy::Report>), 
         None => (job.clone(), None),
         Some(plan) => (plan.job, Some(plan.report)),
     })
+}
+
+/// Admission control ([`cosdem_job::admission`]): estimates the job's memory and disk before
+/// anything is allocated and refuses it when its share in this process (`in_process`: the
+/// DEM assemblies too) exceeds `limit` bytes (`None`: not checked). Returns the warnings to
+/// show (a run that would write more than 10 GiB or 100 000 files), also logged. A DEM job
+/// whose one assembly's exported state cannot fit in a message of `max_message_bytes` (the
+/// pool's; states are split over as many messages as they need, but one state is not) is
+/// refused naming the packing.
+pub fn admit(
+    job: &Job,
+    limit: Option<u64>,
+    in_process: bool,
+    max_message_bytes: usize,
+) -> Result<Vec<String>, RunError> {
+    if let MaterialSection::Dem { assembly } = &job.material {
+        let discs = assembly.disc_count_hint();
+        let bytes = cosdem_dem::spec::state_bytes(discs);
+        if bytes > max_message_bytes as u64 {
+            return Err(RunError::StateTooLarge { discs, bytes, limit: max_message_bytes });
+        }
+    }
+    use cosdem_job::admission::{MeshCounts, estimate};
+    let counts = match MeshCounts::of_job(job) {
+        Some(c) => c,
+        None => MeshCounts::of_mesh(&job.build_mesh()?),
+    };
+    let e = estimate(job, counts);
+    tracing::info!(
+        memory = %cosdem_job::admission::size(e.in_process_share(in_process)),
+        disk = %cosdem_job::admission::size(e.disk_total),
+        "admission estimate"
+    );
+    if let Some(limit) = limit {
+        e.check(limit, in_process)?;
+    }
+    let warnings: Vec<String> =
+        e.disk_warning().map(|w| format!("warning: {w}")).into_iter().collect();
+    for w in &warnings {
+        tracing::warn!("{w}");
+    }
+    Ok(warnings)
 }
 
 /// Writes `dir/accuracy.json`: what the accuracy target picked and why.
@@ -143,14 +195,17 @@ pub fn material_for(
                 .map(|a| a.strip_prefix("dns:").unwrap_or(a).to_string())
                 .collect();
             let mut pool = if addresses.is_empty() {
-                Pool::in_process(job.workers.in_process.max(1), workers.config.clone(), |_| Dem)?
+                let n = Pool::in_process_workers(job.workers.in_process);
+                Pool::in_process(n, workers.config.clone(), |_| Dem)?
             } else {
                 Pool::connect(&addresses, workers.config.clone())?
             };
+            // The disc count from the spec, so that a worker checks its limits before
+            // building and the pool splits and times its requests by it.
             let request = AssemblyRequest {
                 spec_json: serde_json::to_vec(assembly)?,
                 boundary: BoundaryKind::Unspecified,
-                disc_count_hint: 0,
+                disc_count_hint: assembly.disc_count_hint(),
             };
             match saved {
                 // Resume: the assemblies as committed at the checkpoint.
