@@ -47,24 +47,9 @@ fn fresh(name: &str) -> PathBuf {
     dir
 }
 
-/// Every file of a run directory but the lock (pid), the summary (wall time) and the log.
+/// The run directory's files less lock, summary and log.
 fn files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
-    fn walk(root: &Path, dir: &Path, out: &mut BTreeMap<String, Vec<u8>>) {
-        for e in std::fs::read_dir(dir).unwrap().flatten() {
-            let p = e.path();
-            if p.is_dir() {
-                walk(root, &p, out);
-                continue;
-            }
-            let rel = p.strip_prefix(root).unwrap().to_string_lossy().into_owned();
-            if ![".cosdem.lock", "summary.json", "cosdem.log"].contains(&rel.as_str()) {
-                out.insert(rel, std::fs::read(&p).unwrap());
-            }
-        }
-    }
-    let mut out = BTreeMap::new();
-    walk(dir, dir, &mut out);
-    out
+    cosdem_app::output::run_dir::comparable_files(dir).unwrap()
 }
 
 /// The summary's deterministic part: status, steps, DEM steps, the curve's metrics.

@@ -22,25 +22,9 @@ fn fresh(name: &str) -> PathBuf {
     dir
 }
 
-/// Every file under `dir` (relative path -> bytes), less the lock file (it names the pid),
-/// the summary (it holds the wall time) and the log.
+/// The run directory's files less lock, summary and log.
 fn files(dir: &Path) -> BTreeMap<String, Vec<u8>> {
-    fn walk(root: &Path, dir: &Path, out: &mut BTreeMap<String, Vec<u8>>) {
-        for e in std::fs::read_dir(dir).unwrap().flatten() {
-            let p = e.path();
-            if p.is_dir() {
-                walk(root, &p, out);
-            } else {
-                let rel = p.strip_prefix(root).unwrap().to_string_lossy().into_owned();
-                if ![".cosdem.lock", "summary.json", "cosdem.log"].contains(&rel.as_str()) {
-                    out.insert(rel, std::fs::read(&p).unwrap());
-                }
-            }
-        }
-    }
-    let mut out = BTreeMap::new();
-    walk(dir, dir, &mut out);
-    out
+    cosdem_app::output::run_dir::comparable_files(dir).unwrap()
 }
 
 /// A new run into a finished run's directory is refused (nothing touched); with `overwrite`

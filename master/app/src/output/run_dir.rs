@@ -121,6 +121,34 @@ impl Summary {
     }
 }
 
+/// Every file of the run directory `dir` (path relative to it, `/`-separated -> bytes) but the
+/// three that are not a function of the job: the lock file (a pid), `summary.json` (its wall
+/// time) and `cosdem.log`. Two runs of one job, interrupted and resumed or not, on any number
+/// of workers, give equal maps.
+pub fn comparable_files(dir: &Path) -> Result<std::collections::BTreeMap<String, Vec<u8>>> {
+    fn walk(
+        root: &Path,
+        dir: &Path,
+        out: &mut std::collections::BTreeMap<String, Vec<u8>>,
+    ) -> Result<()> {
+        for e in std::fs::read_dir(dir).map_err(super::io_err(dir, "list"))? {
+            let p = e.map_err(super::io_err(dir, "list"))?.path();
+            if p.is_dir() {
+                walk(root, &p, out)?;
+                continue;
+            }
+            let rel = p.strip_prefix(root).unwrap_or(&p).to_string_lossy().replace('\\', "/");
+            if ![super::claim::LOCK_FILE, "summary.json", "cosdem.log"].contains(&rel.as_str()) {
+                out.insert(rel, std::fs::read(&p).map_err(super::io_err(&p, "read"))?);
+            }
+        }
+        Ok(())
+    }
+    let mut out = std::collections::BTreeMap::new();
+    walk(dir, dir, &mut out)?;
+    Ok(out)
+}
+
 /// Writes the run directory; a [`StepObserver`].
 pub struct RunWriter {
     dir: PathBuf,
