@@ -228,6 +228,10 @@ pub(crate) fn run(args: RunArgs) -> Result<()> {
         .snapshots(true)
         .max_steps(args.max_steps)
         .overwrite(args.overwrite)
+        .origin(cosdem_app::output::provenance::Origin {
+            command: std::env::args().collect(),
+            job_text: std::fs::read_to_string(&args.job).ok(),
+        })
         .max_memory(args.max_memory)
         .stop_on_signals()
         .observer(&mut progress);

@@ -1,6 +1,7 @@
 //! `cosdem run` into a directory that holds a previous run: refused with a message naming
 //! `--overwrite` and `--resume`, the previous run's files (its log included) untouched; with
-//! `--overwrite` the previous run is kept as `RUN.old-1`.
+//! `--overwrite` the previous run is kept as `RUN.old-1`. The run keeps the job file as written
+//! and the command line (`job.toml`, `provenance.json`).
 
 use std::path::Path;
 use std::process::Command;
@@ -20,6 +21,11 @@ fn a_rerun_is_refused_without_touching_the_log_and_overwrite_keeps_the_old_run()
     let log = std::fs::read(out.join("cosdem.log")).unwrap();
     let curve = std::fs::read(out.join("curve.csv")).unwrap();
     assert!(!log.is_empty());
+    // Provenance: the job file as written and the command line.
+    let text = std::fs::read_to_string(&job).unwrap();
+    assert_eq!(std::fs::read_to_string(out.join("job.toml")).unwrap(), text);
+    let provenance = std::fs::read_to_string(out.join("provenance.json")).unwrap();
+    assert!(provenance.contains("\"--out\"") && provenance.contains("\"commit\""), "{provenance}");
 
     let refused = cosdem(&args);
     assert!(!refused.status.success());

@@ -16,6 +16,8 @@ pub mod csv;
 pub mod field_data;
 /// PNG figures of a run directory (plotters, embedded font): Figs. 3, 9, 10-12.
 pub mod plot;
+/// Where a run's results come from: `provenance.json` and the copy of the job.
+pub mod provenance;
 /// ParaView `.pvd` collections: the time series of `.vtu` files.
 pub mod pvd;
 /// A run directory cut back to its checkpoint's step on a resume.

@@ -122,8 +122,8 @@ impl Summary {
 }
 
 /// Every file of the run directory `dir` (path relative to it, `/`-separated -> bytes) but the
-/// three that are not a function of the job: the lock file (a pid), `summary.json` (its wall
-/// time) and `cosdem.log`. Two runs of one job, interrupted and resumed or not, on any number
+/// four that are not a function of the job: the lock file (a pid), `summary.json` (its wall
+/// time), `provenance.json` (dates, command lines) and `cosdem.log`. Two runs of one job, interrupted and resumed or not, on any number
 /// of workers, give equal maps.
 pub fn comparable_files(dir: &Path) -> Result<std::collections::BTreeMap<String, Vec<u8>>> {
     fn walk(
@@ -138,7 +138,9 @@ pub fn comparable_files(dir: &Path) -> Result<std::collections::BTreeMap<String,
                 continue;
             }
             let rel = p.strip_prefix(root).unwrap_or(&p).to_string_lossy().replace('\\', "/");
-            if ![super::claim::LOCK_FILE, "summary.json", "cosdem.log"].contains(&rel.as_str()) {
+            let skipped =
+                [super::claim::LOCK_FILE, "summary.json", super::provenance::FILE, "cosdem.log"];
+            if !skipped.contains(&rel.as_str()) {
                 out.insert(rel, std::fs::read(&p).map_err(super::io_err(&p, "read"))?);
             }
         }

@@ -12,6 +12,7 @@ use super::observer::{RunObserver, Silent, StepHook};
 use super::{RunError, WorkerChoice, gauss_point_ids, material_for, run_settings, tuned};
 use crate::checkpoint::{self, Checkpoint, Checkpointer};
 use crate::output::claim::{Claim, Mode};
+use crate::output::provenance::{self, Origin};
 use crate::output::run_dir::{RunWriter, Summary};
 use crate::output::snapshots::resolve_snapshot_ids;
 use cosdem_common::GaussPointId;
@@ -87,6 +88,7 @@ pub struct Run<'a> {
     resume: Option<bool>,
     overwrite: bool,
     max_memory: Option<u64>,
+    origin: Option<Origin>,
     checkpoints: bool,
     snapshots: bool,
     max_steps: Option<u64>,
@@ -111,6 +113,7 @@ impl<'a> Run<'a> {
             resume: None,
             overwrite: false,
             max_memory: None,
+            origin: None,
             checkpoints: false,
             snapshots: false,
             max_steps: None,
@@ -158,6 +161,14 @@ impl<'a> Run<'a> {
     /// ([`cosdem_job::admission::default_memory_limit`]). `u64::MAX`: no limit.
     pub fn max_memory(mut self, bytes: Option<u64>) -> Self {
         self.max_memory = bytes;
+        self
+    }
+
+    /// Where the job comes from, for the run directory's provenance (`provenance.json`, the
+    /// copy of the job): the command line and the job file's text. Default: the process's
+    /// command line, the job written out as TOML.
+    pub fn origin(mut self, origin: Origin) -> Self {
+        self.origin = Some(origin);
         self
     }
 
@@ -218,6 +229,7 @@ impl<'a> Run<'a> {
             resume,
             overwrite,
             max_memory,
+            origin,
             checkpoints,
             snapshots,
             max_steps,
@@ -302,6 +314,9 @@ impl<'a> Run<'a> {
             (Some(claim), Some(dir)) => {
                 let lock = claim.commit()?;
                 observer.on_dir(dir).map_err(RunError::Observer)?;
+                let origin = origin.unwrap_or_else(Origin::of_process);
+                let resumed_at = checkpoint.as_ref().map(|c| c.solver.step);
+                provenance::record(dir, self.job, &origin, resumed_at)?;
                 if let Some(report) = &report {
                     super::write_accuracy_report(report, dir)?;
                 }
