@@ -102,7 +102,7 @@ pub struct WorkerConfig {
     pub listen: SocketAddr,
     /// Shared secret; required when `listen` is not a loopback address.
     pub token: Option<Token>,
-    /// Relaxation threads (0 = one per core).
+    /// Relaxation threads (0 = one per core; more than the cores count as the cores).
     pub threads: usize,
     /// Limits.
     pub limits: Limits,
@@ -143,12 +143,29 @@ impl WorkerConfig {
         Ok(())
     }
 
-    /// Relaxation threads actually used.
+    /// Relaxation threads actually used: `threads`, at most the machine's cores (more would
+    /// only contend for them, and results do not depend on the thread count), or one per
+    /// core for 0.
     pub fn thread_count(&self) -> usize {
-        if self.threads > 0 {
-            self.threads
-        } else {
-            std::thread::available_parallelism().map_or(1, |n| n.get())
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        match self.threads {
+            0 => cores,
+            n => n.min(cores),
         }
+    }
+}
+
+#[cfg(test)]
+mod thread_tests {
+    use super::WorkerConfig;
+
+    /// `--threads 100000` made a pool of 100 000 threads: the count is capped at the cores.
+    #[test]
+    fn thread_counts_are_capped_at_the_cores() {
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        let with = |threads| WorkerConfig { threads, ..WorkerConfig::default() }.thread_count();
+        assert_eq!(with(0), cores);
+        assert_eq!(with(100_000), cores);
+        assert_eq!(with(1), 1);
     }
 }

@@ -27,6 +27,10 @@ pub struct WorkerService<M: MicroModel> {
 impl<M: MicroModel> WorkerService<M> {
     /// A service with its own relaxation thread pool.
     pub fn new(model: M, config: WorkerConfig) -> Result<Self, ServiceError> {
+        if config.threads > config.thread_count() {
+            let cores = config.thread_count();
+            tracing::warn!(asked = config.threads, cores, "relaxation threads capped at the cores");
+        }
         let relax = rayon::ThreadPoolBuilder::new()
             .num_threads(config.thread_count())
             .thread_name(|i| format!("cosdem-relax-{i}"))
