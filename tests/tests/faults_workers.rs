@@ -35,8 +35,8 @@ fn a_worker_lost_at_any_phase_of_a_step_leaves_the_run_byte_identical() {
     for action in ["kill", "term", "stop"] {
         cases.push(Case::one("commit", 2, action, false));
     }
-    // A worker that answers garbage (an undecodable reply) is lost like a dead one. (The
-    // export case is the test below: it fails intermittently.)
+    // A worker that answers garbage (an undecodable reply) is lost like a dead one. (At an
+    // export, the ignored test below: it can fail when the pool migrates.)
     cases.push(Case::one("solve", 3, "garbage", true));
     // A second loss during the first one's recovery: worker 2 killed at its first
     // ImportState (the restore of worker 1's assemblies), after a solve or an export.
@@ -48,21 +48,21 @@ fn a_worker_lost_at_any_phase_of_a_step_leaves_the_run_byte_identical() {
     suite.print();
 }
 
-/// A worker that answers garbage to step 2's checkpoint export, and stays up. Intermittent:
-/// it failed once in about ten full runs of the suite (in `.ci/run`, 2026-12-05) with
-/// "checkpoint: element 1 gauss point 2 is committed at step 1, the solver at step 2": a
-/// state the checkpoint took was the previous checkpoint's. Not reproduced in isolation (8
-/// runs, nor in 12 under CPU load). A lead: the fault counts ExportState calls, and a
-/// rebalancing at a step boundary (driven by measured solve times, so by the machine's load)
-/// exports too, so on a loaded machine the garbage may hit a migration's export
-/// (`Pool::step_boundary`) instead of the checkpoint's; another suspect is the lost worker that
-/// still answers and is admitted again with its old assemblies. Issue 27 stays open on it; run
+/// A worker that answers garbage to an export and stays up, with the pool migrating
+/// assemblies at every step (`rebalance_threshold` near 1): about half the runs (3 of 8)
+/// fail with "checkpoint: element E gauss point P is committed at step 1, the solver at step
+/// 2", a state of the previous step reaching the checkpoint. With the default threshold the
+/// same fault finished byte-identical in 20 of 21 runs (one failure in `.ci/run`, 2026-12-05,
+/// when the machine's load made the pool migrate). Killed, terminated and stopped workers at
+/// the same phases passed with the same threshold (one run of the phases above): the worker
+/// that is lost but still answers (admitted again at the next step boundary, holding its old
+/// assemblies), together with migrations, is the open case. Issue 27 stays open on it; run
 /// with `--ignored`.
 #[test]
-#[ignore = "intermittent, under investigation (issue 27): see the doc comment"]
-fn a_worker_answering_garbage_to_an_export_leaves_the_run_byte_identical() {
+#[ignore = "open bug (issue 27): a garbage-answering worker that stays up, with migrations"]
+fn a_worker_answering_garbage_to_an_export_with_migrations_leaves_the_run_byte_identical() {
     let mut suite = Suite::new("export-garbage");
-    suite.survives(&Case::one("export", 3, "garbage", true));
+    suite.survives(&Case::one("export", 3, "garbage", true).rebalancing(1.0001));
     suite.print();
 }
 

@@ -74,11 +74,33 @@ pub struct Case {
     pub fault: String,
     pub second: Option<String>,
     pub defer_commits: bool,
+    /// The pool's `rebalance_threshold` (default 1.25; near 1 migrates at every step).
+    pub rebalance_threshold: Option<f64>,
 }
 
 impl Case {
     pub fn one(phase: &str, n: u32, action: &str, defer_commits: bool) -> Case {
-        Case { fault: format!("{phase}:{n}:{action}"), second: None, defer_commits }
+        Case {
+            fault: format!("{phase}:{n}:{action}"),
+            second: None,
+            defer_commits,
+            rebalance_threshold: None,
+        }
+    }
+
+    /// Rebalances (migrates assemblies) whenever the loads differ by more than `threshold`.
+    pub fn rebalancing(mut self, threshold: f64) -> Case {
+        self.rebalance_threshold = Some(threshold);
+        self
+    }
+
+    /// The pool's settings for the case.
+    pub fn config(&self) -> PoolConfig {
+        let base = config(self.defer_commits);
+        PoolConfig {
+            rebalance_threshold: self.rebalance_threshold.unwrap_or(base.rebalance_threshold),
+            ..base
+        }
     }
 
     /// A second fault, on worker 2.
@@ -88,7 +110,10 @@ impl Case {
     }
 
     pub fn name(&self) -> String {
-        let calls = if self.defer_commits { "" } else { " (commit calls)" };
+        let mut calls = if self.defer_commits { String::new() } else { " (commit calls)".into() };
+        if let Some(t) = self.rebalance_threshold {
+            calls.push_str(&format!(" (rebalance threshold {t})"));
+        }
         match &self.second {
             Some(f) => format!("{} then {f}{calls}", self.fault),
             None => format!("{}{calls}", self.fault),
@@ -116,14 +141,12 @@ pub fn workers(faults: [Option<&str>; 3], log: &Path) -> Vec<WorkerProcess> {
 pub fn run(
     dir: &Path,
     procs: &[WorkerProcess],
-    defer_commits: bool,
+    config: PoolConfig,
     resume: bool,
 ) -> Result<RunOutcome, RunError> {
     let job = job();
-    let choice = WorkerChoice {
-        addresses: procs.iter().map(|p| p.addr.to_string()).collect(),
-        config: config(defer_commits),
-    };
+    let choice =
+        WorkerChoice { addresses: procs.iter().map(|p| p.addr.to_string()).collect(), config };
     let run = Run::new(&job, dir).workers(choice).checkpoints(true);
     if resume { run.resume(false) } else { run }.execute()
 }
@@ -182,7 +205,7 @@ pub fn reference() -> &'static Outputs {
     REFERENCE.get_or_init(|| {
         let (dir, log) = fresh("reference");
         let procs = workers([None; 3], &log);
-        let outcome = run(&dir, &procs, true, false).expect("the reference run");
+        let outcome = run(&dir, &procs, config(true), false).expect("the reference run");
         assert!(matches!(outcome.ending, Ending::Finished), "reference: {:?}", outcome.ending);
         assert_eq!(outcome.steps, 4, "the reference run must reach its end");
         Outputs::read(&dir)
@@ -217,7 +240,7 @@ impl Suite {
         let (dir, log) = fresh(&name);
         let mut procs = workers([None, Some(&case.fault), case.second.as_deref()], &log);
         let t = Instant::now();
-        let outcome = run(&dir, &procs, case.defer_commits, false);
+        let outcome = run(&dir, &procs, case.config(), false);
         let took = t.elapsed();
         let fired = std::fs::read_to_string(&log).unwrap_or_default();
         let fate = fate(&mut procs[1], Duration::from_secs(3));
@@ -248,7 +271,7 @@ impl Suite {
         let name = format!("{fault} on every worker");
         let (dir, log) = fresh(&name);
         let procs = workers([Some(fault.as_str()); 3], &log);
-        let outcome = run(&dir, &procs, true, false);
+        let outcome = run(&dir, &procs, config(true), false);
         drop(procs);
         let (failed, ok) = match &outcome {
             Ok(o) => match &o.ending {
@@ -271,7 +294,7 @@ impl Suite {
             return;
         }
         let procs = workers([None; 3], &log);
-        let outcome = run(&dir, &procs, true, true);
+        let outcome = run(&dir, &procs, config(true), true);
         let (outcome, ok) = match outcome {
             Err(e) => (format!("resume refused: {e}"), false),
             Ok(o) if !matches!(o.ending, Ending::Finished) => {
