@@ -5,48 +5,29 @@
 
 use crate::schema::Job;
 use cosdem_fem::error::{Error, Result};
-use cosdem_fem::gmsh::file_kind;
-use std::io::Read;
+use cosdem_fem::gmsh::{GmshError, read_regular};
 use std::path::Path;
 
 /// Largest job file read (16 MiB): a job is a few kB of TOML; the largest legitimate one (a
 /// long explicit `radii` list of [`cosdem_dem::spec::MAX_DISCS`] radii) stays below it.
 pub const MAX_JOB_FILE_BYTES: u64 = 16 << 20;
 
-/// The text of the regular file `path`, at most [`MAX_JOB_FILE_BYTES`] bytes of it.
+/// The text of the regular file `path`, at most [`MAX_JOB_FILE_BYTES`] bytes of it
+/// ([`read_regular`], the mesh reader's check).
 fn read_job_file(path: &Path) -> Result<String> {
     let err = |message: String| Error::JobFile { file: path.display().to_string(), message };
-    let too_large = |size: u64| {
-        err(format!(
+    let bytes = read_regular(path, MAX_JOB_FILE_BYTES).map_err(|e| match e {
+        GmshError::NotAFile { kind, .. } => {
+            err(format!("it is {kind}, not a regular file: a job file must be a plain file"))
+        }
+        GmshError::TooLarge { size, .. } => err(format!(
             "{size} bytes ({:.1} MiB) is more than the {} MiB (MAX_JOB_FILE_BYTES) a job file may hold",
             size as f64 / f64::from(1 << 20),
             MAX_JOB_FILE_BYTES >> 20
-        ))
-    };
-    let not_a_file = |meta: &std::fs::Metadata| {
-        err(format!(
-            "it is {}, not a regular file: a job file must be a plain file",
-            file_kind(meta)
-        ))
-    };
-    // Checked before opening: opening a FIFO blocks until a writer comes.
-    let meta = std::fs::metadata(path).map_err(|e| err(e.to_string()))?;
-    if !meta.is_file() {
-        return Err(not_a_file(&meta));
-    }
-    if meta.len() > MAX_JOB_FILE_BYTES {
-        return Err(too_large(meta.len()));
-    }
-    let file = std::fs::File::open(path).map_err(|e| err(e.to_string()))?;
-    let meta = file.metadata().map_err(|e| err(e.to_string()))?;
-    if !meta.is_file() {
-        return Err(not_a_file(&meta));
-    }
-    let mut bytes = Vec::with_capacity(meta.len().min(MAX_JOB_FILE_BYTES) as usize);
-    file.take(MAX_JOB_FILE_BYTES + 1).read_to_end(&mut bytes).map_err(|e| err(e.to_string()))?;
-    if bytes.len() as u64 > MAX_JOB_FILE_BYTES {
-        return Err(too_large(bytes.len() as u64));
-    }
+        )),
+        GmshError::Io { source, .. } => err(source.to_string()),
+        other => err(other.to_string()),
+    })?;
     String::from_utf8(bytes).map_err(|e| err(format!("not UTF-8 text: {e}")))
 }
 

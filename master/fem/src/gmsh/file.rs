@@ -9,8 +9,8 @@ use std::io::Read;
 use std::path::Path;
 
 /// What a file that is not a regular one is (`a directory`, `a character device`, ...), for
-/// messages that refuse it (the job file's reader uses it too).
-pub fn file_kind(meta: &Metadata) -> &'static str {
+/// messages that refuse it.
+fn file_kind(meta: &Metadata) -> &'static str {
     let t = meta.file_type();
     if t.is_dir() {
         return "a directory";
@@ -34,8 +34,9 @@ pub fn file_kind(meta: &Metadata) -> &'static str {
     "not a regular file"
 }
 
-/// The bytes of the regular file `path`, at most `limit` of them.
-pub(super) fn read_regular(path: &Path, limit: u64) -> Result<Vec<u8>> {
+/// The bytes of the regular file `path`, at most `limit` of them (the mesh reader's and the
+/// job file's): anything else is [`GmshError::NotAFile`] or [`GmshError::TooLarge`].
+pub fn read_regular(path: &Path, limit: u64) -> Result<Vec<u8>> {
     let io = |source| GmshError::Io { path: path.to_path_buf(), source };
     let not_a_file =
         |meta: &Metadata| GmshError::NotAFile { path: path.to_path_buf(), kind: file_kind(meta) };

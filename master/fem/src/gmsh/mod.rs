@@ -35,7 +35,7 @@ mod ascii;
 mod binary;
 mod build;
 mod file;
-pub use file::file_kind;
+pub use file::read_regular;
 mod records;
 mod v22;
 mod v41;
