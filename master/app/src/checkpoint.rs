@@ -262,7 +262,8 @@ pub fn newton_digest(job: &Job) -> u64 {
     fnv1a(&serde_json::to_string(&job.newton).unwrap_or_default())
 }
 
-fn fnv1a(text: &str) -> u64 {
+/// FNV-1a, 64 bits: the digests of a job (here and in the run directory's provenance).
+pub(crate) fn fnv1a(text: &str) -> u64 {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
     for b in text.bytes() {
         h ^= u64::from(b);

@@ -83,12 +83,7 @@ impl Provenance {
 
 /// The job's digest: FNV-1a 64 of its canonical JSON, as 16 hex digits.
 pub fn job_digest(job: &Job) -> String {
-    let text = serde_json::to_string(job).unwrap_or_default();
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for b in text.bytes() {
-        h ^= u64::from(b);
-        h = h.wrapping_mul(0x0000_0100_0000_01b3);
-    }
+    let h = crate::checkpoint::fnv1a(&serde_json::to_string(job).unwrap_or_default());
     format!("{h:016x}")
 }
 
