@@ -62,14 +62,17 @@ impl Pool {
                 Ok(())
             })
             .await?;
-        // What a failed source was to give stays where it is (restored, if it was lost).
+        // What a failed source was to give stays where it is (restored, if it was lost), and
+        // a destination lost in the export round takes nothing: a worker lost by a bad answer
+        // may still answer an import, and what it took would be owned by a dead worker (its
+        // held-back commits are not sent, its assemblies would not be restored).
         failed_sources.extend_from_slice(lost.workers());
         for from in failed_sources {
             for list in by_dest.values_mut() {
                 list.retain(|(_, f)| *f != from);
             }
         }
-        by_dest.retain(|_, list| !list.is_empty());
+        by_dest.retain(|to, list| !list.is_empty() && !lost.workers().contains(to));
         let mut jobs = Vec::new();
         for (to, list) in &by_dest {
             let mut states = Vec::with_capacity(list.len());
