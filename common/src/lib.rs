@@ -17,4 +17,6 @@ pub mod voigt;
 
 pub use gauss::GaussPointId;
 pub use kinematics::{KinematicsError, MacroDeformation};
-pub use response::{Answer, MicroDiagnostics, MicroResponse, StressVector, Tangent};
+pub use response::{
+    Answer, MicroDescriptors, MicroDiagnostics, MicroResponse, StressVector, Tangent,
+};

@@ -34,6 +34,45 @@ pub struct MicroDiagnostics {
     /// Estimated bound on the stress error the shortcut adds: the largest component of the
     /// extrapolated stress increment `|C de|` (Pa, or N for couple stresses), 0 when relaxed.
     pub error_bound: f64,
+    /// Micro-structure of the assembly that answered (of the last relaxed state for a
+    /// shortcut answer); `None` for analytical materials.
+    pub descriptors: Option<MicroDescriptors>,
+}
+
+/// Micro-structure descriptors of a DEM assembly, as FEMxDEM studies publish them per Gauss
+/// point. Computed from the state after the solve, never changing it. Contacts are the active
+/// ones of the homogenization (overlapping or touching within 1e-9 of the radii sum).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct MicroDescriptors {
+    /// Porosity `1 - sum(pi r^2) / A` of the current cell of area `A = det(Fbar) V` (overlaps
+    /// counted twice: negligible at the small overlaps of stiff contacts).
+    pub porosity: f64,
+    /// Void ratio `A / sum(pi r^2) - 1`.
+    pub void_ratio: f64,
+    /// Coordination number `2 N_c / N` over all discs.
+    pub coordination: f64,
+    /// Mechanical coordination number `2 (N_c - N_c1) / (N - N_0 - N_1)` without the rattlers
+    /// (the `N_0` discs with no contact and the `N_1` with one, whose `N_c1` contacts go with
+    /// them; 0 when every disc rattles).
+    pub mechanical_coordination: f64,
+    /// Contact-normal fabric `F_xx = (1/N_c) sum n_x n_x` (0 without contacts).
+    pub fabric_xx: f64,
+    /// Contact-normal fabric `F_yy` (`F_xx + F_yy = 1` with contacts).
+    pub fabric_yy: f64,
+    /// Contact-normal fabric `F_xy`.
+    pub fabric_xy: f64,
+    /// Fabric anisotropy `a = 2 (f_1 - f_2) / (f_1 + f_2)` from the principal values
+    /// `f_1 >= f_2` of the fabric (the `a` of `E(theta) = (1 + a cos 2(theta - theta_a)) /
+    /// (2 pi)`); 0 for an isotropic fabric or without contacts.
+    pub anisotropy: f64,
+    /// Major principal direction `theta_a` of the fabric, radians from x in `(-pi/2, pi/2]`
+    /// (meaningless when `anisotropy` is at rounding level).
+    pub fabric_direction: f64,
+    /// Fraction of the contacts whose tangential force is at the Coulomb limit `mu_s F_n`.
+    pub sliding_fraction: f64,
+    /// Mean disc rotation (rad, counter-clockwise positive) since the discs were placed, over
+    /// the discs whose rotation is finite.
+    pub mean_rotation: f64,
 }
 
 /// How a material point produced its answer.

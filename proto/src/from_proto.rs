@@ -6,7 +6,8 @@ use cosdem_common::micro::{
 };
 use cosdem_common::voigt::N;
 use cosdem_common::{
-    GaussPointId, KinematicsError, MacroDeformation, MicroDiagnostics, MicroResponse,
+    GaussPointId, KinematicsError, MacroDeformation, MicroDescriptors, MicroDiagnostics,
+    MicroResponse,
 };
 
 /// Why a wire message does not make a domain value.
@@ -76,6 +77,25 @@ impl From<pb::MicroDiagnostics> for MicroDiagnostics {
             answer: cosdem_common::Answer::from_code(d.answer),
             unrelaxed_increment: d.unrelaxed_increment,
             error_bound: d.error_bound,
+            descriptors: d.descriptors.map(MicroDescriptors::from),
+        }
+    }
+}
+
+impl From<pb::MicroDescriptors> for MicroDescriptors {
+    fn from(d: pb::MicroDescriptors) -> Self {
+        MicroDescriptors {
+            porosity: d.porosity,
+            void_ratio: d.void_ratio,
+            coordination: d.coordination,
+            mechanical_coordination: d.mechanical_coordination,
+            fabric_xx: d.fabric_xx,
+            fabric_yy: d.fabric_yy,
+            fabric_xy: d.fabric_xy,
+            anisotropy: d.anisotropy,
+            fabric_direction: d.fabric_direction,
+            sliding_fraction: d.sliding_fraction,
+            mean_rotation: d.mean_rotation,
         }
     }
 }

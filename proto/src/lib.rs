@@ -23,8 +23,10 @@ pub use text::printable;
 /// The protocol version a master and a worker must agree on at handshake. 2: a SolveBatch
 /// may carry the commit of the previous step (a worker of protocol 1 would ignore it). 3: the
 /// assembly spec has `relaxation.substep` (a worker of protocol 2 refuses the spec with an
-/// unknown field; the handshake says so first, naming both versions).
-pub const PROTOCOL_VERSION: u32 = 3;
+/// unknown field; the handshake says so first, naming both versions). 4: the diagnostics of
+/// every answer carry the micro descriptors (porosity, coordination, fabric, sliding, mean
+/// rotation; a master of protocol 3 would drop them without a word, so it is refused).
+pub const PROTOCOL_VERSION: u32 = 4;
 
 /// Default limit on one gRPC message, both directions (256 MiB): large assemblies'
 /// exported states and snapshots must pass.

@@ -4,7 +4,9 @@ use crate::v1 as pb;
 use cosdem_common::micro::{
     AssemblyInfo, AssemblyRequest, AssemblyState, BoundaryKind, MicroSnapshot,
 };
-use cosdem_common::{GaussPointId, MacroDeformation, MicroDiagnostics, MicroResponse};
+use cosdem_common::{
+    GaussPointId, MacroDeformation, MicroDescriptors, MicroDiagnostics, MicroResponse,
+};
 
 impl From<GaussPointId> for pb::GaussPoint {
     fn from(id: GaussPointId) -> Self {
@@ -39,6 +41,25 @@ impl From<&MicroDiagnostics> for pb::MicroDiagnostics {
             answer: d.answer.code(),
             unrelaxed_increment: d.unrelaxed_increment,
             error_bound: d.error_bound,
+            descriptors: d.descriptors.as_ref().map(pb::MicroDescriptors::from),
+        }
+    }
+}
+
+impl From<&MicroDescriptors> for pb::MicroDescriptors {
+    fn from(d: &MicroDescriptors) -> Self {
+        pb::MicroDescriptors {
+            porosity: d.porosity,
+            void_ratio: d.void_ratio,
+            coordination: d.coordination,
+            mechanical_coordination: d.mechanical_coordination,
+            fabric_xx: d.fabric_xx,
+            fabric_yy: d.fabric_yy,
+            fabric_xy: d.fabric_xy,
+            anisotropy: d.anisotropy,
+            fabric_direction: d.fabric_direction,
+            sliding_fraction: d.sliding_fraction,
+            mean_rotation: d.mean_rotation,
         }
     }
 }

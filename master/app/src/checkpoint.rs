@@ -9,18 +9,19 @@
 //! solve is deterministic given (committed state, target), and everything else is restored
 //! exactly (postcard writes each `f64` as its 8 little-endian bytes).
 //!
-//! Format `CDEMCKP4`: the 8-byte header `CDEMCKP4`, one postcard [`Checkpoint`] (serde with a
+//! Format `CDEMCKP7`: the 8-byte header `CDEMCKP7`, one postcard [`Checkpoint`] (serde with a
 //! specified wire format), and a CRC-32 (IEEE, little-endian) of every byte before it. A
 //! damaged file (a flipped bit anywhere) is refused by its checksum, naming the file; so is a
-//! checkpoint of the older bincode formats (`CDEMCKP1`, `CDEMCKP2`) of an earlier cosdem,
-//! by name: that run must be restarted.
+//! checkpoint of the older formats of an earlier cosdem (`CDEMCKP1`, `CDEMCKP2`: bincode;
+//! `CDEMCKP4`: postcard without the solver's stage and the answers' micro descriptors), by
+//! name: that run must be restarted.
 //!
 //! The checksum is a CRC-32 (`crc32fast`) rather than a 64-bit hash: it is guaranteed to catch
 //! every single-bit error and every burst of up to 32 bits (a damaged disk block, a bad copy),
 //! it is the standard polynomial any zlib recomputes, and it runs at memory speed; a damaged
 //! file that matches by chance (2^-32) is no concern for a check against damage. The version
-//! is 4, not 3: `'3'` is one bit from the older `'2'` and `'1'`, so a flipped bit in a new
-//! header could pass for an older format; `'4'` is two bits from either. The assembly states
+//! is 7: `'7'` is two bits from each of the older `'1'`, `'2'` and `'4'`, so a single flipped
+//! bit in a header cannot pass for another format (3, 5 and 6 are one bit from one of them). The assembly states
 //! inside (`cosdem_dem::Assembly::to_bytes`) carry a checksum of their own, made the same way.
 //!
 //! The checkpoint also stores a digest of the job's physics (mesh, loading, material) and one
@@ -43,11 +44,12 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// The header of the format written (postcard and a CRC-32).
-const MAGIC: &[u8; 8] = b"CDEMCKP4";
+const MAGIC: &[u8; 8] = b"CDEMCKP7";
 
-/// The headers of the bincode formats of earlier cosdems: `CDEMCKP1` (before the Newton
-/// settings had a digest of their own) and `CDEMCKP2`. Refused by name.
-const OLD_MAGICS: [&[u8; 8]; 2] = [b"CDEMCKP1", b"CDEMCKP2"];
+/// The headers of the formats of earlier cosdems: `CDEMCKP1` (bincode, before the Newton
+/// settings had a digest of their own), `CDEMCKP2` (bincode) and `CDEMCKP4` (postcard, before
+/// stages and micro descriptors). Refused by name.
+const OLD_MAGICS: [&[u8; 8]; 3] = [b"CDEMCKP1", b"CDEMCKP2", b"CDEMCKP4"];
 
 /// Bytes of the trailing CRC-32.
 const CRC_LEN: usize = 4;
@@ -158,7 +160,7 @@ impl Checkpoint {
             return Err(bad(
                 path,
                 format!(
-                    "the checkpoint is in {}, the older bincode format of an earlier cosdem, \
+                    "the checkpoint is in {}, an older format of an earlier cosdem, \
                      which this cosdem no longer reads: the run must be restarted (or resumed \
                      with the cosdem that wrote it)",
                     String::from_utf8_lossy(&old[..])
@@ -168,7 +170,7 @@ impl Checkpoint {
         if head != MAGIC {
             return Err(bad(
                 path,
-                "not a cosdem checkpoint (no CDEMCKP4 header), or its header is damaged".into(),
+                "not a cosdem checkpoint (no CDEMCKP7 header), or its header is damaged".into(),
             ));
         }
         if bytes.len() < MAGIC.len() + CRC_LEN {
@@ -251,10 +253,17 @@ impl Digests {
     }
 }
 
-/// FNV-1a digest of the job's physics: `[mesh]`, `[loading]`, `[material]` as JSON. Output
-/// and worker settings may change between a run and its resume.
+/// FNV-1a digest of the job's physics: `[mesh]`, `[loading]`, `[material]` and, in a job
+/// that has them, its `[[stage]]`s, as JSON (a job without stages keeps the digest it had
+/// before stages existed). Output and worker settings may change between a run and its
+/// resume.
 pub fn job_digest(job: &Job) -> u64 {
-    fnv1a(&serde_json::to_string(&(&job.mesh, &job.loading, &job.material)).unwrap_or_default())
+    let json = if job.stage.is_empty() {
+        serde_json::to_string(&(&job.mesh, &job.loading, &job.material))
+    } else {
+        serde_json::to_string(&(&job.mesh, &job.loading, &job.material, &job.stage))
+    };
+    fnv1a(&json.unwrap_or_default())
 }
 
 /// FNV-1a digest of the job's `[newton]` settings as JSON.

@@ -10,6 +10,7 @@
 //! cosdem bench tradeoff-plot DIR/tradeoff.csv [--out PNG] [--title T]
 //! cosdem bench tradeoff-specimens SWEEP_DIR SWEEP_DIR... [--out DIR] [--title T]
 //! cosdem plot RUN_DIR
+//! cosdem export RUN_DIR --format yade|lammps|vtu [--out DIR]
 //! ```
 //! `run` checkpoints into `RUN/checkpoint.bin` (every `[output] checkpoint_every` steps);
 //! Ctrl-C or SIGTERM stops after the current step (checkpoint written, status `interrupted`,
@@ -26,6 +27,7 @@
 //! (with its speed/accuracy sweeps in [`tradeoff`]); [`logging`] sets up the run's log.
 
 mod bench;
+mod export;
 mod logging;
 mod plot;
 mod run;
@@ -61,6 +63,8 @@ enum Command {
         /// The run directory (holds curve.csv), or a study directory (holds study.json).
         run_dir: PathBuf,
     },
+    /// Every Gauss point's packing at the run's checkpoint as YADE, LAMMPS or VTU files.
+    Export(export::ExportArgs),
     /// Benchmarks of the coupling (see `cosdem_study::bench`): printed figures.
     Bench {
         #[command(subcommand)]
@@ -80,6 +84,7 @@ fn main() -> Result<()> {
         Command::Rve(args) => rve::rve(args),
         Command::Study { what } => study::study(what),
         Command::Plot { run_dir } => plot::plot(&run_dir),
+        Command::Export(args) => export::export(args),
         Command::Bench { what } => bench::bench(what),
     }
 }

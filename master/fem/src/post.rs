@@ -56,7 +56,7 @@ pub struct CurveMetrics {
     /// `None` while the curve has not passed its peak (the last point is the peak).
     pub residual_load: Option<f64>,
     /// Stiffness E: least-squares slope through the origin of the points with displacement
-    /// `<= linear_range` (N/m per metre).
+    /// in `(0, linear_range]` (N/m per metre).
     pub stiffness: Option<f64>,
     /// The paper's Fig. 5 stiffness E50 = (F_u / 2) / d50, with d50 the displacement at which
     /// the load first reaches F_u / 2 (linear interpolation between points).
@@ -76,11 +76,7 @@ impl CurveMetrics {
         let residual_load = (ipk + 1 < curve.len())
             .then(|| curve[ipk + 1..].iter().map(|p| p.1).fold(f64::INFINITY, f64::min));
         let (mut sxy, mut sxx) = (0.0, 0.0);
-        // The displacements are sums of increments: the point meant to sit on the range's end
-        // can be an ulp beyond it (20 steps of 5e-5 m reach 0.0010000000000000002 m), and
-        // dropping it made two runs of the same curve fit E over different points.
-        let end = linear_range * (1.0 + RANGE_SLACK);
-        for &(d, f) in curve.iter().filter(|p| p.0 <= end) {
+        for &(d, f) in curve.iter().filter(|p| in_linear_range(p.0, linear_range)) {
             sxy += d * f;
             sxx += d * d;
         }
@@ -98,6 +94,71 @@ impl CurveMetrics {
         }
         let stiffness_50 = d50.filter(|d| *d > 0.0).map(|d| half / d);
         Self { peak_load: fpk, peak_displacement: dpk, residual_load, stiffness, stiffness_50 }
+    }
+}
+
+/// A displacement `d` within the linear range `(0, linear_range]`. The displacements are sums
+/// of increments: the point meant to sit on the range's end can be an ulp beyond it (20 steps
+/// of 5e-5 m reach 0.0010000000000000002 m), and dropping it made two runs of the same curve
+/// fit E over different points, hence the [`RANGE_SLACK`].
+fn in_linear_range(d: f64, linear_range: f64) -> bool {
+    d > 0.0 && d <= linear_range * (1.0 + RANGE_SLACK)
+}
+
+/// Whether a curve has passed its peak, and why a metric of [`CurveMetrics`] is absent.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct CurveNotes {
+    /// A point after the largest load has a smaller load: the largest load is a peak (F_u).
+    /// `false` while the load still rises (or stays level) at the last step: the reported
+    /// `peak_load` is then only the largest load so far.
+    pub peak_reached: bool,
+    /// Why there is no peak (absent when `peak_reached`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub no_peak: Option<String>,
+    /// Why the stiffness E is absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub no_stiffness: Option<String>,
+    /// Why E50 is absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub no_stiffness_50: Option<String>,
+}
+
+impl CurveMetrics {
+    /// The metrics of [`CurveMetrics::from_curve`] for a general boundary-value curve, with
+    /// what is missing said: a curve whose load has not fallen after its maximum has no peak
+    /// (`peak_reached: false` with the reason), and then no E50 either (half of a peak not yet
+    /// known); E is absent when no point lies in `(0, linear_range]`.
+    pub fn assess(curve: &[(f64, f64)], linear_range: f64) -> (Self, CurveNotes) {
+        let mut m = Self::from_curve(curve, linear_range);
+        let mut notes = CurveNotes::default();
+        if curve.is_empty() {
+            let why = "no converged step yet".to_string();
+            notes.no_peak = Some(why.clone());
+            notes.no_stiffness = Some(why.clone());
+            notes.no_stiffness_50 = Some(why);
+            return (m, notes);
+        }
+        notes.peak_reached = m.residual_load.is_some();
+        if !notes.peak_reached {
+            let (d, f) = curve[curve.len() - 1];
+            notes.no_peak = Some(format!(
+                "the load has not fallen after its largest value: it is {f:e} at the last \
+                 point (control displacement {d:e}); peak_load is the largest load so far"
+            ));
+            m.stiffness_50 = None;
+            notes.no_stiffness_50 = Some("no peak reached: F_u / 2 is not known".into());
+        } else if m.stiffness_50.is_none() {
+            notes.no_stiffness_50 = Some(format!(
+                "the peak load {:e} is not positive or is reached at a displacement <= 0",
+                m.peak_load
+            ));
+        }
+        if m.stiffness.is_none() {
+            notes.no_stiffness = Some(format!(
+                "no point with a control displacement in (0, linear_range = {linear_range:e}]"
+            ));
+        }
+        (m, notes)
     }
 }
 
@@ -158,6 +219,79 @@ mod curve_tests {
         let beyond = [(5e-4, 500.0), (1e-3 * (1.0 + 1e-6), 5e3)];
         let e = CurveMetrics::from_curve(&beyond, 1e-3).stiffness.unwrap();
         assert!((e / 1e6 - 1.0).abs() < 1e-12, "{e}");
+    }
+
+    /// A straight line F = k d (no peak): E = k exactly over any range, the peak is said not
+    /// reached, E50 is absent with its reason, and the largest load is the last point's.
+    #[test]
+    fn a_straight_line_has_its_slope_and_no_peak() {
+        let k = 3.5e6;
+        let curve: Vec<_> = (1..=30).map(|i| (1e-4 * i as f64, k * 1e-4 * i as f64)).collect();
+        let (m, notes) = CurveMetrics::assess(&curve, 1e-3);
+        assert!((m.stiffness.unwrap() / k - 1.0).abs() < 1e-14);
+        assert!(!notes.peak_reached);
+        assert!(notes.no_peak.as_deref().unwrap().contains("has not fallen"), "{notes:?}");
+        assert_eq!(m.stiffness_50, None);
+        assert!(notes.no_stiffness_50.is_some() && notes.no_stiffness.is_none());
+        assert_eq!((m.peak_displacement, m.peak_load), curve[29]);
+        assert_eq!(m.residual_load, None);
+    }
+
+    /// A parabola F = a d (2 p - d) sampled past its peak at d = p: F_u = a p^2 at p; E is the
+    /// least-squares slope through the origin of the sampled points, closed form
+    /// `2 a p - a sum d^3 / sum d^2`; E50 = (F_u / 2) / d50 with `d50 = p (1 - 1/sqrt 2)`,
+    /// up to the linear interpolation between points (chord error below `a h^2 / 8` in load
+    /// for a step h, relative error below 1e-4 here); the residual is the last point's load.
+    #[test]
+    fn a_curve_with_a_known_peak() {
+        let (a, p, h) = (1e8, 0.02, 1e-4);
+        let f = |d: f64| a * d * (2.0 * p - d);
+        let curve: Vec<_> = (1..=300).map(|i| (h * i as f64, f(h * i as f64))).collect();
+        let range = 2e-3;
+        let (m, notes) = CurveMetrics::assess(&curve, range);
+        assert!(notes.peak_reached && notes.no_peak.is_none(), "{notes:?}");
+        assert!((m.peak_load / (a * p * p) - 1.0).abs() < 1e-12);
+        assert!((m.peak_displacement - p).abs() < 1e-12);
+        assert_eq!(m.residual_load, Some(curve[299].1));
+        let lin: Vec<f64> = curve.iter().map(|c| c.0).filter(|&d| d <= range + 1e-15).collect();
+        let (s2, s3): (f64, f64) =
+            (lin.iter().map(|d| d * d).sum(), lin.iter().map(|d| d.powi(3)).sum());
+        let e = 2.0 * a * p - a * s3 / s2;
+        assert!((m.stiffness.unwrap() / e - 1.0).abs() < 1e-12, "{:?} vs {e}", m.stiffness);
+        let d50 = p * (1.0 - 1.0 / 2f64.sqrt());
+        let e50 = 0.5 * a * p * p / d50;
+        assert!(
+            (m.stiffness_50.unwrap() / e50 - 1.0).abs() < 1e-4,
+            "{:?} vs {e50}",
+            m.stiffness_50
+        );
+    }
+
+    /// A monotonic hardening curve F = F_inf (1 - exp(-d / d0)): no peak at any length (said
+    /// so, E50 absent); E is the least-squares slope through the origin of the sampled points,
+    /// `F_inf sum d (1 - exp(-d/d0)) / sum d^2`, evaluated independently here.
+    #[test]
+    fn a_monotonic_hardening_curve_has_no_peak() {
+        let (f_inf, d0, h) = (5e4, 0.01, 5e-4);
+        let curve: Vec<_> =
+            (1..=200).map(|i| (h * i as f64, f_inf * (1.0 - (-h * i as f64 / d0).exp()))).collect();
+        let (m, notes) = CurveMetrics::assess(&curve, 0.005);
+        assert!(!notes.peak_reached);
+        assert_eq!(m.stiffness_50, None);
+        assert_eq!(m.residual_load, None);
+        let pts = &curve[..10];
+        let e = pts.iter().map(|(d, f)| d * f).sum::<f64>()
+            / pts.iter().map(|(d, _)| d * d).sum::<f64>();
+        assert!((m.stiffness.unwrap() / e - 1.0).abs() < 1e-12);
+        // Below the initial slope F_inf / d0 (the curve bends down), above the secant at 5 mm.
+        assert!(e < f_inf / d0 && e > f_inf * (1.0 - (-0.5f64).exp()) / 0.005);
+        // A settlement left negative (no scale) has no point in (0, linear_range]: E absent.
+        let neg: Vec<_> = curve.iter().map(|&(d, f)| (-d, f)).collect();
+        let (m, notes) = CurveMetrics::assess(&neg, 0.005);
+        assert_eq!(m.stiffness, None);
+        assert!(notes.no_stiffness.as_deref().unwrap().contains("linear_range"));
+        let (_, notes) = CurveMetrics::assess(&[], 0.005);
+        assert!(notes.no_peak.is_some() && !notes.peak_reached);
     }
 
     /// Before the peak is passed there is no residual capacity.

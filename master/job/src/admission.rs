@@ -251,6 +251,12 @@ fn packing_keys(p: &PackingSpec) -> Vec<String> {
         PackingSpec::Random { r_min, r_max, side, .. } => {
             vec![k("side", *side), k("r_min", *r_min), k("r_max", *r_max)]
         }
+        PackingSpec::Explicit { radii, .. } => {
+            vec![format!("material.assembly.packing.file = ({} discs)", radii.len())]
+        }
+        PackingSpec::File { file, .. } => {
+            vec![format!("material.assembly.packing.file = {:?}", file.display().to_string())]
+        }
     }
 }
 

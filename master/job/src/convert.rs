@@ -156,19 +156,27 @@ impl Job {
                 ),
             });
         }
+        if let Some(curve) = &self.output.curve {
+            curve.check_sets(&mesh)?;
+        }
+        self.check_stage_sets(&mesh)?;
         Ok(cosdem_fem::solve::Model {
             mesh,
             field: self.field(),
             rule: self.rule(),
-            loading: self.loading(),
+            loading: match self.is_staged() {
+                true => self.stages()?.swap_remove(0).loading,
+                false => self.loading(),
+            },
         })
     }
 
     /// Newton and step settings.
     pub fn solver_settings(&self) -> Result<SolverSettings> {
         let l = &self.loading;
-        let steps = match (l.increment, &l.compression) {
-            (Some(inc), Some(c)) => SolverSettings::steps_for_increment(c.displacement, inc)?,
+        let steps = match (l.increment, &l.compression, self.stage.first()) {
+            (_, _, Some(first)) => first.steps,
+            (Some(inc), Some(c), None) => SolverSettings::steps_for_increment(c.displacement, inc)?,
             _ => l.steps,
         };
         let n = &self.newton;

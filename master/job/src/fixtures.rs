@@ -12,6 +12,8 @@
 //! - `dem-one-element`: one Q8 element of four hexagonal DEM assemblies, 100 kPa on both
 //!   sides, 4 mm in 2 steps, Newton tolerances 5e-3;
 //! - `gmsh-square`: the 2 x 2 Q8 Gmsh square of `master/fem/tests/data`, elastic.
+//! - `packing-file`: `dem-one-element` with its assemblies read from the YADE packing
+//!   `examples/packings/random-270.txt` (`kind = "file"`).
 
 use crate::Job;
 use std::path::{Path, PathBuf};

@@ -12,7 +12,9 @@
 //! - `material`: reading `[material]` as a plain struct, so errors keep their TOML position;
 //! - `load`: reading TOML text or a regular file of at most [`MAX_JOB_FILE_BYTES`]
 //!   ([`Job::from_toml`], [`Job::load`]);
+//! - `packing_file`: a `kind = "file"` packing read on the master into its explicit discs;
 //! - `validate`: ranges and combinations ([`Job::validate`]);
+//! - `curve`: `[output.curve]`, the curve's axes, and the `.pvd` time rule ([`Job::pvd_time`]);
 //! - `convert`: the FE model, the solver settings and the elastic material ([`Job::model`],
 //!   [`Job::solver_settings`], [`Job::elastic`]);
 //! - `admission`: the memory and disk a job will need, estimated before anything is
@@ -22,17 +24,27 @@
 pub mod admission;
 mod arrays;
 mod convert;
+mod curve;
 #[cfg(any(test, feature = "fixtures"))]
 pub mod fixtures;
 mod load;
 mod material;
+mod packing_file;
 mod schema;
+mod stage;
 mod validate;
 
+pub use curve::{CurveQuantity, CurveSection, PvdTime};
 pub use load::MAX_JOB_FILE_BYTES;
+pub use packing_file::MAX_PACKING_FILE_BYTES;
 pub use schema::{
     ComponentChoice, Compression, Continuum, ElementChoice, Integration, Job, LoadingSection,
     MaterialSection, MeshKind, MeshSection, Moving, NewtonSection, OutputSection,
-    PAPER_LINEAR_RANGE, PlatenChoice, Prescribed, PressureLoad, RampChoice, WorkersSection,
+    PAPER_LINEAR_RANGE, PlatenChoice, Prescribed, PressureLoad, RampChoice, VtkFormat,
+    WorkersSection,
+};
+pub use stage::{
+    MAX_STAGES, SolverStage, StageGravity, StagePrescribed, StagePressure, StageRamp, StageSection,
+    StageTraction,
 };
 pub use validate::MAX_TANGENT_STRAIN;

@@ -33,17 +33,26 @@ fn read_job_file(path: &Path) -> Result<String> {
 
 impl Job {
     /// Parses a job from TOML text; `origin` names the file in errors.
+    /// A packing file it names is read relative to the working directory.
     pub fn from_toml(text: &str, origin: &str) -> Result<Self> {
-        let job: Job = toml::from_str(text)
+        Self::parse(text, origin, Path::new(""))
+    }
+
+    /// Parses `text`, reads its packing file (relative to `base`) and validates.
+    fn parse(text: &str, origin: &str, base: &Path) -> Result<Self> {
+        let mut job: Job = toml::from_str(text)
             .map_err(|e| Error::JobFile { file: origin.to_string(), message: e.to_string() })?;
+        crate::packing_file::resolve(&mut job, base, origin)?;
         job.validate()?;
         Ok(job)
     }
 
-    /// Reads and validates a job file; relative paths inside it are resolved against it.
+    /// Reads and validates a job file; relative paths inside it (`mesh.file`, a packing
+    /// `file`) are resolved against it.
     pub fn load(path: &Path) -> Result<Self> {
         let text = read_job_file(path)?;
-        let mut job = Self::from_toml(&text, &path.display().to_string())?;
+        let base = path.parent().unwrap_or(Path::new("."));
+        let mut job = Self::parse(&text, &path.display().to_string(), base)?;
         if let Some(file) = &job.mesh.file
             && file.is_relative()
         {

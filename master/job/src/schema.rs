@@ -24,6 +24,9 @@ pub struct Job {
     /// Boundary conditions, loads and load steps.
     #[serde(default)]
     pub loading: LoadingSection,
+    /// The loading in stages (`[[stage]]`), instead of `[loading]`'s loads.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub stage: Vec<crate::stage::StageSection>,
     /// The material at the Gauss points.
     pub material: MaterialSection,
     /// Newton-Raphson and step control.
@@ -355,6 +358,23 @@ pub struct OutputSection {
     /// Upper end (m) of the linear range the stiffness E is fitted over
     /// ([`cosdem_fem::post::CurveMetrics`]); the paper's 0.01 m.
     pub linear_range: f64,
+    /// `[output.curve]`: the curve's control displacement, load and extra reaction columns;
+    /// absent: the platen compression's curve.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub curve: Option<crate::curve::CurveSection>,
+    /// Encoding of the `.vtu` files: `ascii` (default) or `binary` (zlib-compressed base64).
+    pub vtk_format: VtkFormat,
+}
+
+/// `[output] vtk_format`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum VtkFormat {
+    /// Readable text (the default).
+    #[default]
+    Ascii,
+    /// Inline base64 of zlib-compressed little-endian data (`vtkZLibDataCompressor`).
+    Binary,
 }
 
 /// The paper's linear range for the stiffness E: displacements up to 0.01 m.
@@ -369,6 +389,8 @@ impl Default for OutputSection {
             field_plots_at: Vec::new(),
             checkpoint_every: 1,
             linear_range: PAPER_LINEAR_RANGE,
+            curve: None,
+            vtk_format: VtkFormat::Ascii,
         }
     }
 }

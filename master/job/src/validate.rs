@@ -32,10 +32,16 @@ fn positive(field: &'static str, v: f64) -> Result<f64> {
 /// `material.assembly.packing.side`). The DEM spec names its fields relative to the assembly
 /// with `&'static str`; the dotted keys are interned once each (the spec has a few dozen).
 fn assembly_key(field: &str) -> &'static str {
+    interned(format!("material.assembly.{field}"))
+}
+
+/// A dotted job-file key made at run time (`stage[2].pressure[0].value`, a field of
+/// `[material.assembly]`) as the `&'static str` errors carry: each distinct key is leaked once
+/// (a job names a few dozen).
+pub(crate) fn interned(key: String) -> &'static str {
     static KEYS: LazyLock<Mutex<BTreeMap<String, &'static str>>> = LazyLock::new(Mutex::default);
     let mut keys = KEYS.lock().unwrap_or_else(|e| e.into_inner());
-    keys.entry(field.to_string())
-        .or_insert_with(|| Box::leak(format!("material.assembly.{field}").into_boxed_str()))
+    keys.entry(key.clone()).or_insert_with(|| Box::leak(key.into_boxed_str()))
 }
 
 /// A value formatted by `Display` made readable: every number in it written out in more
@@ -76,6 +82,7 @@ impl Job {
     pub fn validate(&self) -> Result<()> {
         self.validate_mesh()?;
         self.validate_loading()?;
+        self.validate_stages()?;
         self.validate_material()?;
         let n = &self.newton;
         if n.max_iterations == 0 {
@@ -120,6 +127,9 @@ impl Job {
             if !(d.is_finite() && d >= 0.0) {
                 return Err(bad("output.field_plots_at", num(d), "must be finite and >= 0 (m)"));
             }
+        }
+        if let Some(curve) = &self.output.curve {
+            curve.validate(self.mesh.continuum)?;
         }
         Ok(())
     }

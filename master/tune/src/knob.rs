@@ -6,7 +6,7 @@
 
 use crate::table::TableError;
 use cosdem_dem::AssemblySpec;
-use cosdem_dem::spec::{Driver, PackingSpec, TangentKind};
+use cosdem_dem::spec::{Driver, TangentKind};
 use cosdem_job::{Job, MaterialSection};
 
 /// One setting of the sweep: a label and the job it produces.
@@ -235,10 +235,9 @@ impl Knob {
             Knob::RelaxationSkipBelow => format!("{:e}", a.relaxation.skip_below),
             Knob::RelaxationElasticShortcut => a.relaxation.elastic_shortcut.to_string(),
             Knob::RelaxationSubstep => format!("{:e}", a.relaxation.substep),
-            Knob::AssemblySide => match a.packing {
-                PackingSpec::Hexagonal { side, .. } | PackingSpec::Random { side, .. } => {
-                    format!("{side} m")
-                }
+            Knob::AssemblySide => match a.packing.side() {
+                Some(side) => format!("{side} m"),
+                None => format!("given ({} packing)", a.packing.kind()),
             },
             Knob::LoadStep | Knob::NewtonSecantUpdates | Knob::NewtonStallIterations => {
                 unreachable!("answered above")
@@ -307,11 +306,7 @@ impl Knob {
             Knob::RelaxationSubstep => a.relaxation.substep = number().ok_or_else(unknown)?,
             Knob::AssemblySide => {
                 let s = number().ok_or_else(unknown)?;
-                match &mut a.packing {
-                    PackingSpec::Hexagonal { side, .. } | PackingSpec::Random { side, .. } => {
-                        *side = s;
-                    }
-                }
+                *a.packing.side_mut().ok_or_else(unknown)? = s;
             }
             Knob::LoadStep | Knob::NewtonSecantUpdates | Knob::NewtonStallIterations => {
                 unreachable!("applied above")
@@ -341,12 +336,8 @@ impl Knob {
             }
             Knob::RelaxationSubstep => a.relaxation.substep = to.relaxation.substep,
             Knob::AssemblySide => {
-                let (PackingSpec::Hexagonal { side: s, .. } | PackingSpec::Random { side: s, .. }) =
-                    to.packing;
-                match &mut a.packing {
-                    PackingSpec::Hexagonal { side, .. } | PackingSpec::Random { side, .. } => {
-                        *side = s;
-                    }
+                if let (Some(s), Some(side)) = (to.packing.side(), a.packing.side_mut()) {
+                    *side = s;
                 }
             }
         }
@@ -449,23 +440,16 @@ fn scale_load_step(job: &mut Job, f: f64) {
 /// four largest diameters (the worker refuses a smaller side). The setting prints the side to
 /// 3 decimals; the job takes it unrounded.
 fn side_moves(base: &Job, a: &AssemblySpec) -> Vec<Variant> {
-    let (side, smallest) = match a.packing {
-        PackingSpec::Hexagonal { radius, side } => (side, 8.0 * radius),
-        PackingSpec::Random { side, r_max, ref radii, .. } => {
-            (side, 8.0 * radii.iter().copied().fold(r_max, f64::max))
-        }
-    };
+    // An explicit disc list (a packing file) has no side to shrink.
+    let Some(side) = a.packing.side() else { return Vec::new() };
+    let smallest = 8.0 * a.packing.largest_radius();
     let mut v = Vec::new();
     for f in [0.5, 0.75] {
         let s = (side * f).max(smallest);
         if s < side {
             let mut job = base.clone();
-            if let Some(a) = assembly_mut(&mut job) {
-                match &mut a.packing {
-                    PackingSpec::Hexagonal { side, .. } | PackingSpec::Random { side, .. } => {
-                        *side = s;
-                    }
-                }
+            if let Some(side) = assembly_mut(&mut job).and_then(|a| a.packing.side_mut()) {
+                *side = s;
             }
             v.push(Variant { knob: Knob::AssemblySide.name(), setting: format!("{s:.3}"), job });
         }

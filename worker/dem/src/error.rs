@@ -21,6 +21,18 @@ pub enum Error {
     /// The packing request cannot be satisfied (e.g. the confining stress was not reached).
     #[error("packing failed: {0}")]
     Packing(String),
+    /// A packing file cannot be read, or does not map onto a 2D specimen.
+    #[error("packing file {file}{}: {value}: {reason}", at_line(*.line))]
+    PackingFile {
+        /// The file, as the job names it.
+        file: String,
+        /// Line of the offending value (1-based; 0: the file as a whole).
+        line: usize,
+        /// The offending value, formatted.
+        value: String,
+        /// What a valid file holds.
+        reason: String,
+    },
     /// The explicit integration produced non-finite values.
     #[error("relaxation diverged after {steps} steps (non-finite state)")]
     Diverged {
@@ -39,6 +51,11 @@ pub enum Error {
     /// A serialized assembly could not be decoded.
     #[error("cannot decode assembly state: {0}")]
     Decode(String),
+}
+
+/// `, line N` (nothing for line 0: the file as a whole).
+fn at_line(line: usize) -> String {
+    if line == 0 { String::new() } else { format!(", line {line}") }
 }
 
 /// Result alias of the worker crate.

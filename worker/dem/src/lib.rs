@@ -2,8 +2,8 @@
 //! gRPC service around it is `cosdem-worker`).
 //!
 //! Data path: [`spec`] -> [`packing`] -> [`assembly`] (committed / trial state) ->
-//! [`broadphase`] -> [`contact`] -> [`integrate`] (with [`boundary`]) -> [`homogenize`] ->
-//! `MicroResponse`.
+//! [`broadphase`] -> [`contact`] -> [`integrate`] (with [`boundary`]) -> [`homogenize`] (and
+//! [`descriptors`]) -> `MicroResponse`.
 //!
 //! # Readings of THEORY.md fixed here
 //! - Branch vectors to the contact point (`a_p = r_p - d/2`) in the slip rate and torques,
@@ -29,6 +29,8 @@ pub mod boundary;
 pub mod broadphase;
 /// Contact law: normal, tangential and rolling sub-models and the force kernel.
 pub mod contact;
+/// Micro-structure descriptors: porosity, coordination, fabric, sliding, rotation.
+pub mod descriptors;
 /// The crate's error type.
 pub mod error;
 /// The fluctuation field (Eq. 35) and the affine fit of a deformed assembly.

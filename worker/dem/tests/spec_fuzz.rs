@@ -151,6 +151,7 @@ fn small(spec: &AssemblySpec) -> bool {
         PackingSpec::Random { confining_stress, .. } => {
             n <= 12.0 && (1e3..=1e7).contains(confining_stress)
         }
+        PackingSpec::Explicit { .. } | PackingSpec::File { .. } => n <= 300.0,
     }
 }
 

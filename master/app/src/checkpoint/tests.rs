@@ -42,6 +42,9 @@ fn settings(job: &Job) -> RunSettings {
         vtk_every: 1,
         internal_length: 0.01,
         linear_range: 0.01,
+        curve: None,
+        pvd_time: crate::output::run_dir::PvdTime::Displacement,
+        vtk_encoding: crate::output::Encoding::Ascii,
     }
 }
 
@@ -195,6 +198,8 @@ fn awkward() -> Checkpoint {
             committed: None,
             gauss_points: Vec::new(),
             reactions: BTreeMap::from([("top".to_string(), [1.5, -0.0, 7e-310])]),
+            stage: 2,
+            stage_start: Some(vec![-0.0, 1e-3, f64::MIN_POSITIVE]),
         },
         assemblies: vec![SavedAssembly {
             id: GaussPointId::new(0, 3),
@@ -221,7 +226,7 @@ fn round_trip_is_bit_exact() {
     let c = awkward();
     c.write(&path).unwrap();
     let bytes = std::fs::read(&path).unwrap();
-    assert_eq!(&bytes[..8], b"CDEMCKP4");
+    assert_eq!(&bytes[..8], b"CDEMCKP7");
     let back = Checkpoint::read(&path).unwrap();
     let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
     assert_eq!(bits(&back.solver.u), bits(&c.solver.u));
@@ -237,7 +242,7 @@ fn round_trip_is_bit_exact() {
 }
 
 /// Every single-bit flip of a small checkpoint is refused with the file named: in the header
-/// as a damaged or foreign header (never as an older format: version 4 is two bits from the
+/// as a damaged or foreign header (never as an older format: version 7 is two bits from each
 /// older ones), in the body and in the checksum itself by the checksum. All bits are tried.
 #[test]
 fn every_flipped_bit_is_refused_naming_the_file() {
@@ -252,7 +257,7 @@ fn every_flipped_bit_is_refused_naming_the_file() {
         let e = Checkpoint::read(&path).unwrap_err().to_string();
         assert!(e.contains(&path.display().to_string()), "bit {bit}: {e}");
         if bit < 64 {
-            assert!(e.contains("no CDEMCKP4 header") && e.contains("damaged"), "bit {bit}: {e}");
+            assert!(e.contains("no CDEMCKP7 header") && e.contains("damaged"), "bit {bit}: {e}");
         } else {
             assert!(e.contains("damaged: the CRC-32"), "bit {bit}: {e}");
         }
@@ -260,18 +265,18 @@ fn every_flipped_bit_is_refused_naming_the_file() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// A checkpoint of the older bincode formats, or a file that is none of ours, is refused with
+/// A checkpoint of an older format, or a file that is none of ours, is refused with
 /// an error that says which.
 #[test]
 fn old_and_foreign_files_are_refused_by_name() {
     let dir = scratch("format");
     let path = dir.join(FILE);
-    for old in ["CDEMCKP1", "CDEMCKP2"] {
+    for old in ["CDEMCKP1", "CDEMCKP2", "CDEMCKP4"] {
         std::fs::write(&path, format!("{old} and whatever bincode followed")).unwrap();
         let e = Checkpoint::read(&path).unwrap_err().to_string();
         assert!(
             e.contains(old)
-                && e.contains("older bincode format of an earlier cosdem")
+                && e.contains("an older format of an earlier cosdem")
                 && e.contains("must be restarted")
                 && e.contains(FILE),
             "{e}"
@@ -280,7 +285,7 @@ fn old_and_foreign_files_are_refused_by_name() {
     std::fs::write(&path, b"PK\x03\x04 a zip file").unwrap();
     let foreign = Checkpoint::read(&path).unwrap_err().to_string();
     assert!(foreign.contains("not a cosdem checkpoint"), "{foreign}");
-    std::fs::write(&path, b"CDEMCKP4").unwrap();
+    std::fs::write(&path, b"CDEMCKP7").unwrap();
     let short = Checkpoint::read(&path).unwrap_err().to_string();
     assert!(short.contains("truncated"), "{short}");
     std::fs::remove_dir_all(&dir).unwrap();

@@ -12,8 +12,14 @@
 pub mod claim;
 /// CSV curves (load-displacement), one flushed row per converged step.
 pub mod csv;
+/// The curve of any boundary-value job: control displacement, load, extra reactions.
+pub mod curve_axes;
 /// The equivalent-strain field of chosen steps as JSON, for the Fig. 9 plot.
 pub mod field_data;
+/// Gauss-point values averaged to the mesh's nodes (the mesh `.vtu`'s nodal stress).
+pub mod nodal_stress;
+/// Packing files (YADE, LAMMPS, VTU) of snapshots and of checkpointed assemblies.
+pub mod packing;
 /// PNG figures of a run directory (plotters, embedded font): Figs. 3, 9, 10-12.
 pub mod plot;
 /// Where a run's results come from: `provenance.json` and the copy of the job.
@@ -30,6 +36,8 @@ pub mod snapshots;
 pub mod visuals;
 /// VTK XML unstructured grids (`.vtu`): meshes, Gauss-point clouds, particle snapshots.
 pub mod vtk;
+/// zlib-compressed binary arrays of `.vtu` files (`vtkZLibDataCompressor`).
+pub mod vtk_zlib;
 /// Reading back the `.vtu` files this crate writes.
 pub mod vtu_read;
 

@@ -12,16 +12,18 @@
 //! job, so two runs can be compared byte for byte.
 
 use super::csv::CsvWriter;
+use super::curve_axes::CurveAxes;
 use super::pvd::PvdWriter;
 use super::snapshots::{SnapshotInbox, SnapshotTap};
 use super::visuals::{StepInfo, VisualOutputs, reached as done};
-use super::vtk::{gauss_point_piece, nodal_piece, write_vtu};
+use super::vtk::{DataArray, gauss_point_piece, nodal_piece, write_vtu_encoded};
 use super::{OutputError, Result, write_atomic};
 use cosdem_common::Answer;
 use cosdem_common::GaussPointId;
 use cosdem_fem::material::Material;
-use cosdem_fem::post::CurveMetrics;
+use cosdem_fem::post::{CurveMetrics, CurveNotes};
 use cosdem_fem::solve::{SolutionView, StepObserver, StepReport};
+pub use cosdem_job::PvdTime;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -37,6 +39,10 @@ pub const CURVE_COLUMNS: [&str; 8] = [
     "dem_steps",
     "unconverged_points",
 ];
+
+/// Column of `curve.csv` after [`CURVE_COLUMNS`] in every run but a compression without
+/// `[output.curve]`: the pseudo-time (stages finished plus the stage's load factor).
+pub const TIME_COLUMN: &str = "time";
 
 /// What the run writer needs to know about the job.
 #[derive(Clone, Debug)]
@@ -55,6 +61,34 @@ pub struct RunSettings {
     pub internal_length: f64,
     /// Upper end of the linear range for the stiffness E (m).
     pub linear_range: f64,
+    /// `[output.curve]`: the curve's axes and extra reaction columns; `None`: the platen
+    /// compression's curve (`load_factor * shortening`, `-R_y` of `load_set`).
+    pub curve: Option<CurveAxes>,
+    /// What the `.pvd` timesteps are ([`cosdem_job::Job::pvd_time`]).
+    pub pvd_time: PvdTime,
+    /// Encoding of the `.vtu` files.
+    pub vtk_encoding: super::Encoding,
+}
+
+impl RunSettings {
+    /// A compression job without `[output.curve]`: `curve.csv`, the `.pvd` series and
+    /// `summary.json` are exactly what they were before the table existed.
+    fn is_compression_curve(&self) -> bool {
+        self.curve.is_none() && self.pvd_time == PvdTime::Displacement
+    }
+
+    /// The columns of `curve.csv`: [`CURVE_COLUMNS`], then (but for a compression job
+    /// without `[output.curve]`) [`TIME_COLUMN`] and the curve's reaction columns.
+    pub fn columns(&self) -> Vec<String> {
+        let mut c: Vec<String> = CURVE_COLUMNS.iter().map(|s| s.to_string()).collect();
+        if !self.is_compression_curve() {
+            c.push(TIME_COLUMN.into());
+        }
+        if let Some(axes) = &self.curve {
+            c.extend(axes.reaction_columns());
+        }
+        c
+    }
 }
 
 /// The summary, rewritten atomically after every step. It reads back (a field missing from an
@@ -102,6 +136,16 @@ pub struct Summary {
     pub wall_seconds: f64,
     /// Workers used (set by the caller).
     pub workers: usize,
+    /// With `[output.curve]`: its axis labels `[abscissa, ordinate]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub curve_labels: Option<[String; 2]>,
+    /// With `[output.curve]`: whether the peak was passed, and why a metric is absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub curve_notes: Option<CurveNotes>,
+    /// What the `.pvd` timesteps are: `displacement` or `pseudo-time`; absent for a
+    /// compression job without `[output.curve]` (displacement, as before).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pvd_time: Option<PvdTime>,
 }
 
 impl Summary {
@@ -184,12 +228,15 @@ impl RunWriter {
         } else {
             (None, None)
         };
-        let csv = CsvWriter::create(&dir.join("curve.csv"), &CURVE_COLUMNS)?;
-        let summary = Summary {
+        let columns = settings.columns();
+        let columns: Vec<&str> = columns.iter().map(String::as_str).collect();
+        let csv = CsvWriter::create(&dir.join("curve.csv"), &columns)?;
+        let mut summary = Summary {
             title: settings.title.clone(),
             status: "running".into(),
             ..Summary::default()
         };
+        fill_curve_fields(&mut summary, &settings, &[]);
         Self::open(dir, settings, csv, (fields, gauss), Vec::new(), summary, Instant::now())
     }
 
@@ -200,6 +247,7 @@ impl RunWriter {
     pub fn resume(dir: &Path, settings: RunSettings, step: u64) -> Result<Self> {
         let path = dir.join("curve.csv");
         let text = std::fs::read_to_string(&path).map_err(super::io_err(&path, "read"))?;
+        let columns = settings.columns();
         let mut kept = String::new();
         let mut rows: Vec<Vec<f64>> = Vec::new();
         for (i, line) in text.split_inclusive('\n').enumerate() {
@@ -212,7 +260,7 @@ impl RunWriter {
             }
             let values: Vec<f64> =
                 line.trim_end().split(',').filter_map(|v| v.parse().ok()).collect();
-            if values.len() != CURVE_COLUMNS.len() {
+            if values.len() != columns.len() {
                 return Err(super::invalid(
                     &path,
                     format!("line {}: {line:?} is not a curve row", i + 1),
@@ -234,10 +282,14 @@ impl RunWriter {
             ));
         }
         write_atomic(&path, kept.as_bytes())?;
-        let csv = CsvWriter::resume(&path, &CURVE_COLUMNS)?;
+        let names: Vec<&str> = columns.iter().map(String::as_str).collect();
+        let csv = CsvWriter::resume(&path, &names)?;
         let displacement = rows.last().map_or(0.0, |r| r[2]);
-        let displacements: Vec<f64> = rows.iter().map(|r| r[2]).collect();
-        super::restart::cut_back(dir, step, &displacements, settings.vtk_every > 0)?;
+        // The `.pvd` timestep of each kept row: the displacement, or the time column.
+        let time_at =
+            if settings.pvd_time == PvdTime::Displacement { 2 } else { CURVE_COLUMNS.len() };
+        let times: Vec<f64> = rows.iter().map(|r| r[time_at]).collect();
+        super::restart::cut_back(dir, step, &times, settings.vtk_every > 0)?;
         let (fields, gauss) = if settings.vtk_every > 0 {
             std::fs::create_dir_all(dir.join("vtk"))
                 .map_err(super::io_err(dir, "create vtk/ in"))?;
@@ -258,7 +310,7 @@ impl RunWriter {
         let before = old["wall_seconds"].as_f64().unwrap_or(0.0);
         let count = |key: &str| old[key].as_u64().unwrap_or(0);
         let curve: Vec<(f64, f64)> = rows.iter().map(|r| (r[2], r[3])).collect();
-        let summary = Summary {
+        let mut summary = Summary {
             title: settings.title.clone(),
             status: "running".into(),
             steps: step,
@@ -275,6 +327,7 @@ impl RunWriter {
             wall_seconds: before,
             ..Summary::default()
         };
+        fill_curve_fields(&mut summary, &settings, &curve);
         let started = Instant::now()
             .checked_sub(std::time::Duration::from_secs_f64(before.max(0.0)))
             .unwrap_or_else(Instant::now);
@@ -393,8 +446,7 @@ impl RunWriter {
         write_atomic(&path, text.as_bytes())
     }
 
-    fn write_vtk(&mut self, step: u64, view: &SolutionView<'_>) -> Result<()> {
-        let time = self.summary.displacement;
+    fn write_vtk(&mut self, step: u64, time: f64, view: &SolutionView<'_>) -> Result<()> {
         let mesh = view.mesh;
         let npe = mesh.kind.nodes();
         let elements: Vec<Vec<usize>> = mesh.connectivity.chunks(npe).map(|c| c.to_vec()).collect();
@@ -407,7 +459,13 @@ impl RunWriter {
         let path = self.dir.join(format!("vtk/mesh_{step:05}.vtu"));
         let mut piece = nodal_piece(&path, &mesh.nodes, &elements, &dofs)?;
         piece.time = Some(time);
-        write_vtu(&path, &piece)?;
+        super::nodal_stress::add_nodal_stress(
+            &mut piece,
+            mesh.n_nodes(),
+            &elements,
+            view.gauss_points,
+        );
+        write_vtu_encoded(&path, &piece, self.settings.vtk_encoding)?;
         if let Some(pvd) = &mut self.fields {
             pvd.add(time, &path)?;
         }
@@ -417,9 +475,14 @@ impl RunWriter {
         let stress: Vec<[f64; 6]> = gp.iter().map(|g| g.stress).collect();
         let mut piece =
             gauss_point_piece(&positions, &strain, &stress, self.settings.internal_length);
+        super::vtk::add_micro_descriptors(&mut piece, gp.iter().map(|g| g.diagnostics.descriptors));
         piece.time = Some(time);
+        let elements: Vec<u32> = gp.iter().map(|g| g.id.element).collect();
+        let points: Vec<u32> = gp.iter().map(|g| g.id.point).collect();
+        piece.add_point_data(DataArray::ids("element_id", &elements));
+        piece.add_point_data(DataArray::ids("gauss_point_id", &points));
         let path = self.dir.join(format!("vtk/gauss_{step:05}.vtu"));
-        write_vtu(&path, &piece)?;
+        write_vtu_encoded(&path, &piece, self.settings.vtk_encoding)?;
         if let Some(pvd) = &mut self.gauss {
             pvd.add(time, &path)?;
         }
@@ -429,9 +492,18 @@ impl RunWriter {
 
 impl StepObserver for RunWriter {
     fn on_step(&mut self, report: &StepReport, view: &SolutionView<'_>) -> cosdem_fem::Result<()> {
-        let displacement = report.load_factor * self.settings.shortening;
-        let load = -self.settings.load_scale
-            * report.reactions.get(&self.settings.load_set).map_or(0.0, |r| r[1]);
+        let (displacement, load) = match &self.settings.curve {
+            Some(axes) => (axes.control_displacement(view).unwrap_or(0.0), axes.load(report)),
+            None => (
+                report.load_factor * self.settings.shortening,
+                -self.settings.load_scale
+                    * report.reactions.get(&self.settings.load_set).map_or(0.0, |r| r[1]),
+            ),
+        };
+        let time = match self.settings.pvd_time {
+            PvdTime::Displacement => displacement,
+            PvdTime::PseudoTime => report.time,
+        };
         let dem_steps = report.dem_steps;
         let capped = view
             .gauss_points
@@ -455,8 +527,8 @@ impl StepObserver for RunWriter {
         self.summary.cuts += u64::from(report.cuts);
         self.summary.tolerated_steps += u64::from(report.tolerated);
         self.summary.forced_steps += u64::from(report.forced);
-        self.summary.metrics = CurveMetrics::from_curve(&self.curve, self.settings.linear_range);
-        let row = [
+        fill_curve_fields(&mut self.summary, &self.settings, &self.curve);
+        let mut row = vec![
             report.step as f64,
             report.load_factor,
             displacement,
@@ -466,16 +538,23 @@ impl StepObserver for RunWriter {
             dem_steps as f64,
             capped as f64,
         ];
+        if !self.settings.is_compression_curve() {
+            row.push(report.time);
+        }
+        if let Some(axes) = &self.settings.curve {
+            row.extend(axes.reaction_values(report));
+        }
         let io = |e: OutputError| cosdem_fem::Error::Observer(e.to_string());
         self.csv.write_row(&row).map_err(io)?;
         let every = self.settings.vtk_every;
         let on_cadence = every > 0 && report.step.is_multiple_of(every as u64);
         if on_cadence {
-            self.write_vtk(report.step, view).map_err(io)?;
+            self.write_vtk(report.step, time, view).map_err(io)?;
         }
         let info = StepInfo {
             step: report.step,
             displacement,
+            time,
             last: report.load_factor >= 1.0 - 1e-12,
             on_cadence,
             internal_length: self.settings.internal_length,
@@ -483,4 +562,20 @@ impl StepObserver for RunWriter {
         self.visuals.on_step(&self.dir, info, view).map_err(io)?;
         self.write_summary().map_err(io)
     }
+}
+
+/// The summary's curve fields for `curve` so far: the metrics, and with `[output.curve]` its
+/// labels and notes (what is absent and why: [`CurveMetrics::assess`]); the `.pvd` time but
+/// for a compression job without `[output.curve]` (whose summary stays as it was).
+fn fill_curve_fields(summary: &mut Summary, settings: &RunSettings, curve: &[(f64, f64)]) {
+    match &settings.curve {
+        Some(axes) => {
+            let (metrics, notes) = CurveMetrics::assess(curve, settings.linear_range);
+            summary.metrics = metrics;
+            summary.curve_notes = Some(notes);
+            summary.curve_labels = Some(axes.labels());
+        }
+        None => summary.metrics = CurveMetrics::from_curve(curve, settings.linear_range),
+    }
+    summary.pvd_time = (!settings.is_compression_curve()).then_some(settings.pvd_time);
 }

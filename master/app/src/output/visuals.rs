@@ -34,8 +34,11 @@ pub struct VisualOutputs {
 pub struct StepInfo {
     /// Converged step number.
     pub step: u64,
-    /// Macro displacement reached (m).
+    /// Macro displacement reached (m): the curve's abscissa.
     pub displacement: f64,
+    /// The `.pvd` timestep of the step (the displacement or the pseudo-time, see
+    /// [`super::run_dir::RunSettings::pvd_time`]).
+    pub time: f64,
     /// True for the last step of the loading.
     pub last: bool,
     /// True when the step is on the VTK cadence.
@@ -144,6 +147,6 @@ impl VisualOutputs {
             }
         };
         write_vtu(&path, &snapshot_piece(&particles))?;
-        pvd.add(s.displacement, &path)
+        pvd.add(s.time, &path)
     }
 }

@@ -93,12 +93,27 @@ pub struct DataArray {
     pub values: Vec<f64>,
     /// Optional names of the components (`ComponentName0..`): empty, or one per component.
     pub component_names: Vec<String>,
+    /// Stored as `Int32` instead of `Float64` (ids: every value an integer in `i32` range).
+    pub int32: bool,
 }
 
 impl DataArray {
     /// An array of `components`-tuples stored flat.
     pub fn new(name: impl Into<String>, components: usize, values: Vec<f64>) -> Self {
-        DataArray { name: name.into(), components, values, component_names: Vec::new() }
+        DataArray {
+            name: name.into(),
+            components,
+            values,
+            component_names: Vec::new(),
+            int32: false,
+        }
+    }
+
+    /// A scalar `Int32` array of ids (element numbers, point numbers).
+    pub fn ids(name: impl Into<String>, ids: &[u32]) -> Self {
+        let mut a = Self::scalars(name, ids.iter().map(|&i| f64::from(i)).collect());
+        a.int32 = true;
+        a
     }
 
     /// A scalar array.
@@ -194,7 +209,7 @@ impl VtuPiece {
         self.validate(path)?;
         let per_value = match encoding {
             Encoding::Ascii => 24,
-            Encoding::Base64 => 11,
+            Encoding::Base64 | Encoding::Zlib => 11,
         };
         let values: usize = self.points.len() * 3
             + self.cells.iter().map(|c| c.nodes.len() + 2).sum::<usize>()
@@ -203,8 +218,12 @@ impl VtuPiece {
         s.push_str("<?xml version=\"1.0\"?>\n");
         s.push_str(
             "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" \
-             header_type=\"UInt64\">\n  <UnstructuredGrid>\n",
+             header_type=\"UInt64\"",
         );
+        if encoding == Encoding::Zlib {
+            let _ = write!(s, " compressor=\"{}\"", super::vtk_zlib::COMPRESSOR);
+        }
+        s.push_str(">\n  <UnstructuredGrid>\n");
         if let Some(t) = self.time {
             s.push_str("    <FieldData>\n");
             let attrs = "type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\"";
@@ -221,14 +240,22 @@ impl VtuPiece {
             let _ = writeln!(s, "      <{tag}>");
             for a in arrays {
                 let mut attrs = format!(
-                    "type=\"Float64\" Name=\"{}\" NumberOfComponents=\"{}\"",
+                    "type=\"{}\" Name=\"{}\" NumberOfComponents=\"{}\"",
+                    if a.int32 { "Int32" } else { "Float64" },
                     escape(&a.name),
                     a.components
                 );
                 for (i, c) in a.component_names.iter().enumerate() {
                     let _ = write!(attrs, " ComponentName{i}=\"{}\"", escape(c));
                 }
-                push_array(&mut s, 8, &attrs, Values::F64(&a.values, a.components), encoding);
+                let ints: Vec<i32>;
+                let values = if a.int32 {
+                    ints = a.values.iter().map(|&v| v as i32).collect();
+                    Values::I32(&ints)
+                } else {
+                    Values::F64(&a.values, a.components)
+                };
+                push_array(&mut s, 8, &attrs, values, encoding);
             }
             let _ = writeln!(s, "      </{tag}>");
         }
@@ -336,6 +363,11 @@ impl VtuPiece {
                     ));
                 }
                 non_finite(&a.name, &mut a.values.iter().copied())?;
+                let not_i32 =
+                    |v: f64| v.fract() != 0.0 || v < f64::from(i32::MIN) || v > f64::from(i32::MAX);
+                if let Some(v) = a.values.iter().find(|&&v| a.int32 && not_i32(v)) {
+                    return Err(invalid(path, format!("Int32 array {:?} holds {v}", a.name)));
+                }
             }
         }
         Ok(())
@@ -351,6 +383,10 @@ pub enum Encoding {
     /// Raw little-endian bytes, base64-encoded inline (`format="binary"`), each array
     /// preceded by its byte count as a `UInt64`: exact and about half the size.
     Base64,
+    /// zlib-compressed blocks, base64-encoded inline (`format="binary"` under
+    /// `compressor="vtkZLibDataCompressor"`): exact and several times smaller than ASCII
+    /// (see [`super::vtk_zlib`]).
+    Zlib,
 }
 
 /// The contents of one `DataArray`.
@@ -358,6 +394,7 @@ enum Values<'a> {
     /// Values with so many per line (ASCII).
     F64(&'a [f64], usize),
     I64(&'a [i64]),
+    I32(&'a [i32]),
     U8(&'a [u8]),
     /// Connectivity: one cell per line (ASCII).
     Cells(&'a [Cell]),
@@ -368,7 +405,7 @@ fn push_array(s: &mut String, indent: usize, attrs: &str, values: Values<'_>, en
     let pad = " ".repeat(indent);
     let format = match encoding {
         Encoding::Ascii => "ascii",
-        Encoding::Base64 => "binary",
+        Encoding::Base64 | Encoding::Zlib => "binary",
     };
     let _ = writeln!(s, "{pad}<DataArray {attrs} format=\"{format}\">");
     match encoding {
@@ -396,6 +433,11 @@ fn push_array(s: &mut String, indent: usize, attrs: &str, values: Values<'_>, en
                     let _ = writeln!(s, "{pad}  {x}");
                 }
             }
+            Values::I32(v) => {
+                for x in v {
+                    let _ = writeln!(s, "{pad}  {x}");
+                }
+            }
             Values::Cells(cells) => {
                 for c in cells {
                     s.push_str(&pad);
@@ -410,7 +452,7 @@ fn push_array(s: &mut String, indent: usize, attrs: &str, values: Values<'_>, en
                 }
             }
         },
-        Encoding::Base64 => {
+        Encoding::Base64 | Encoding::Zlib => {
             let mut bytes = Vec::new();
             bytes.extend_from_slice(&[0; 8]);
             match values {
@@ -419,6 +461,7 @@ fn push_array(s: &mut String, indent: usize, attrs: &str, values: Values<'_>, en
                 }
                 Values::I64(v) => v.iter().for_each(|x| bytes.extend_from_slice(&x.to_le_bytes())),
                 Values::U8(v) => bytes.extend_from_slice(v),
+                Values::I32(v) => v.iter().for_each(|x| bytes.extend_from_slice(&x.to_le_bytes())),
                 Values::Cells(cells) => cells.iter().flat_map(|c| &c.nodes).for_each(|&n| {
                     bytes.extend_from_slice(&(n as i64).to_le_bytes());
                 }),
@@ -427,7 +470,11 @@ fn push_array(s: &mut String, indent: usize, attrs: &str, values: Values<'_>, en
             bytes[..8].copy_from_slice(&len.to_le_bytes());
             s.push_str(&pad);
             s.push_str("  ");
-            push_base64(s, &bytes);
+            if encoding == Encoding::Zlib {
+                super::vtk_zlib::push_compressed(s, &bytes[8..]);
+            } else {
+                push_base64(s, &bytes);
+            }
             s.push('\n');
         }
     }
@@ -435,7 +482,7 @@ fn push_array(s: &mut String, indent: usize, attrs: &str, values: Values<'_>, en
 }
 
 /// Standard base64 (RFC 4648) with padding.
-fn push_base64(s: &mut String, bytes: &[u8]) {
+pub(super) fn push_base64(s: &mut String, bytes: &[u8]) {
     const ALPHABET: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     s.reserve(bytes.len().div_ceil(3) * 4);
     for chunk in bytes.chunks(3) {
@@ -561,6 +608,41 @@ pub fn particle_piece(
     piece.add_cell_data(DataArray::scalars("normal_force", force));
     piece
 }
+
+// ---- Micro descriptors of the Gauss points (gauss.vtu) -------------------------------------
+
+/// Adds the micro descriptors of the Gauss points of `piece` ([`gauss_point_piece`], one
+/// entry per point, in its order) as point arrays: `porosity`, `void_ratio`, `coordination`,
+/// `mechanical_coordination`, `fabric` (xx, yy, xy: `F = (1/N_c) sum n n`),
+/// `fabric_anisotropy` (`2 (f_1 - f_2) / (f_1 + f_2)`), `fabric_direction` (rad from x),
+/// `sliding_fraction` and `mean_rotation` (rad). Added only when every point carries
+/// descriptors (a DEM material): analytical materials have none, and a `.vtu` holds no NaN.
+pub fn add_micro_descriptors(
+    piece: &mut VtuPiece,
+    descriptors: impl IntoIterator<Item = Option<cosdem_common::MicroDescriptors>>,
+) {
+    let Some(d) = descriptors.into_iter().collect::<Option<Vec<_>>>() else { return };
+    if d.is_empty() {
+        return;
+    }
+    let scalar = |name: &str, f: fn(&cosdem_common::MicroDescriptors) -> f64| {
+        DataArray::scalars(name, d.iter().map(f).collect())
+    };
+    piece.add_point_data(scalar("porosity", |d| d.porosity));
+    piece.add_point_data(scalar("void_ratio", |d| d.void_ratio));
+    piece.add_point_data(scalar("coordination", |d| d.coordination));
+    piece.add_point_data(scalar("mechanical_coordination", |d| d.mechanical_coordination));
+    let fabric: Vec<[f64; 3]> = d.iter().map(|d| [d.fabric_xx, d.fabric_yy, d.fabric_xy]).collect();
+    piece.add_point_data(
+        DataArray::from_tuples("fabric", &fabric).with_component_names(&["xx", "yy", "xy"]),
+    );
+    piece.add_point_data(scalar("fabric_anisotropy", |d| d.anisotropy));
+    piece.add_point_data(scalar("fabric_direction", |d| d.fabric_direction));
+    piece.add_point_data(scalar("sliding_fraction", |d| d.sliding_fraction));
+    piece.add_point_data(scalar("mean_rotation", |d| d.mean_rotation));
+}
+
+// ---- end of the micro descriptors -----------------------------------------------------------
 
 #[cfg(test)]
 mod tests {

@@ -1,7 +1,8 @@
 //! Reading back the `.vtu` files this crate writes (for `cosdem plot`): a small reader of
 //! exactly the layout [`super::vtk::VtuPiece::to_xml_encoded`] produces (one `<DataArray>`
-//! element per array, ASCII or inline base64 with a `UInt64` byte-count header), not a general
-//! VTK reader.
+//! element per array, ASCII, inline base64 with a `UInt64` byte-count header, or inline
+//! zlib-compressed base64 under `compressor="vtkZLibDataCompressor"`), not a general VTK
+//! reader.
 
 use super::vtk::{Cell, CellType, DataArray, VtuPiece};
 use super::{Result, invalid, io_err, unescape};
@@ -30,12 +31,20 @@ pub fn parse_vtu(text: &str, path: &Path) -> Result<VtuPiece> {
     let mut section = Section::None;
     let (mut connectivity, mut offsets, mut types) = (None, None, None);
     let mut rest = text;
+    let mut compressed = false;
     while let Some(open) = rest.find('<') {
         rest = &rest[open..];
         let close = rest.find('>').ok_or_else(|| invalid(path, "unterminated tag".into()))?;
         let tag = &rest[1..close];
         rest = &rest[close + 1..];
         let name = tag.split_whitespace().next().unwrap_or("");
+        if name == "VTKFile" {
+            compressed = match attribute(tag, "compressor") {
+                None => false,
+                Some(c) if c == super::vtk_zlib::COMPRESSOR => true,
+                Some(c) => return Err(invalid(path, format!("unsupported compressor {c:?}"))),
+            };
+        }
         section = match name {
             "FieldData" => Section::Field,
             "PointData" => Section::PointData,
@@ -56,7 +65,7 @@ pub fn parse_vtu(text: &str, path: &Path) -> Result<VtuPiece> {
         let array_name = attribute(tag, "Name").unwrap_or_default();
         let kind = attribute(tag, "type").unwrap_or_default();
         let format = attribute(tag, "format").unwrap_or_else(|| "ascii".into());
-        let values = decode(body, &kind, &format)
+        let values = decode(body, &kind, &format, compressed)
             .map_err(|m| invalid(path, format!("array {array_name:?}: {m}")))?;
         let components: usize = match attribute(tag, "NumberOfComponents") {
             Some(c) => c.parse().map_err(|_| {
@@ -68,6 +77,7 @@ pub fn parse_vtu(text: &str, path: &Path) -> Result<VtuPiece> {
             Section::Field if array_name == "TimeValue" => piece.time = values.first().copied(),
             Section::PointData | Section::CellData => {
                 let mut a = DataArray::new(array_name.clone(), components, values);
+                a.int32 = kind == "Int32";
                 let names: Vec<String> = (0..components)
                     .map_while(|i| attribute(tag, &format!("ComponentName{i}")))
                     .collect();
@@ -151,23 +161,34 @@ pub(crate) fn attribute(tag: &str, name: &str) -> Option<String> {
 }
 
 /// The numbers of one array as `f64` (integers are exact up to 2^53).
-fn decode(body: &str, kind: &str, format: &str) -> std::result::Result<Vec<f64>, String> {
+fn decode(
+    body: &str,
+    kind: &str,
+    format: &str,
+    compressed: bool,
+) -> std::result::Result<Vec<f64>, String> {
     match format {
         "ascii" => body
             .split_whitespace()
             .map(|t| t.parse::<f64>().map_err(|_| format!("{t:?} is not a number")))
             .collect(),
         "binary" => {
-            let bytes = base64(body.trim())?;
-            if bytes.len() < 8 {
-                return Err("binary array shorter than its header".into());
-            }
-            let n = u64::from_le_bytes(bytes[..8].try_into().expect("8 bytes")) as usize;
-            let data = &bytes[8..];
-            if n > data.len() {
-                return Err(format!("header says {n} bytes, {} present", data.len()));
-            }
-            let data = &data[..n];
+            let raw;
+            let data = if compressed {
+                raw = super::vtk_zlib::decode_compressed(body)?;
+                &raw[..]
+            } else {
+                raw = base64(body.trim())?;
+                if raw.len() < 8 {
+                    return Err("binary array shorter than its header".into());
+                }
+                let n = u64::from_le_bytes(raw[..8].try_into().expect("8 bytes")) as usize;
+                let data = &raw[8..];
+                if n > data.len() {
+                    return Err(format!("header says {n} bytes, {} present", data.len()));
+                }
+                &data[..n]
+            };
             let take8 = |c: &[u8]| -> [u8; 8] { c.try_into().expect("8 bytes") };
             Ok(match kind {
                 "Float64" => data.chunks_exact(8).map(|c| f64::from_le_bytes(take8(c))).collect(),
@@ -175,6 +196,10 @@ fn decode(body: &str, kind: &str, format: &str) -> std::result::Result<Vec<f64>,
                     data.chunks_exact(8).map(|c| i64::from_le_bytes(take8(c)) as f64).collect()
                 }
                 "UInt8" => data.iter().map(|&b| f64::from(b)).collect(),
+                "Int32" => data
+                    .chunks_exact(4)
+                    .map(|c| f64::from(i32::from_le_bytes(c.try_into().expect("4 bytes"))))
+                    .collect(),
                 other => return Err(format!("unsupported binary type {other:?}")),
             })
         }
@@ -182,7 +207,8 @@ fn decode(body: &str, kind: &str, format: &str) -> std::result::Result<Vec<f64>,
     }
 }
 
-fn base64(text: &str) -> std::result::Result<Vec<u8>, String> {
+/// Standard base64 (RFC 4648, padded) decoded; whitespace ignored.
+pub(super) fn base64(text: &str) -> std::result::Result<Vec<u8>, String> {
     let value = |c: u8| -> Option<u32> {
         Some(match c {
             b'A'..=b'Z' => c - b'A',
@@ -226,16 +252,17 @@ mod tests {
                 .with_component_names(&["x", "y", "z"]),
         );
         p.add_cell_data(DataArray::scalars("normal_force", vec![0.0, 0.0, 0.0, 12.5]));
+        p.add_point_data(DataArray::ids("element_id", &[0, 7, u32::MAX >> 1]));
         p.time = Some(0.0125);
         p
     }
 
-    /// What is written is read back bit for bit, in both encodings (the writer prints the
+    /// What is written is read back bit for bit, in all three encodings (the writer prints the
     /// shortest round-trip decimal, so ASCII is exact too).
     #[test]
     fn round_trip_both_encodings() {
         let path = Path::new("sample.vtu");
-        for enc in [Encoding::Ascii, Encoding::Base64] {
+        for enc in [Encoding::Ascii, Encoding::Base64, Encoding::Zlib] {
             let p = sample();
             let xml = p.to_xml_encoded(path, enc).unwrap();
             let back = parse_vtu(&xml, path).unwrap();

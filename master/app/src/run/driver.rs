@@ -17,8 +17,8 @@ use crate::output::run_dir::{RunWriter, Summary};
 use crate::output::snapshots::resolve_snapshot_ids;
 use cosdem_common::GaussPointId;
 use cosdem_fem::material::Material;
-use cosdem_fem::solve::Solver;
-use cosdem_job::{Job, admission};
+use cosdem_fem::solve::{Solver, StepObserver};
+use cosdem_job::{Job, SolverStage, admission};
 use std::path::Path;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
@@ -288,6 +288,7 @@ impl<'a> Run<'a> {
         // failed setup leaves a previous run's files as they were.
         let setup = std::time::Instant::now();
         let mut solver = Solver::new(job.model()?, job.solver_settings()?)?;
+        let stages = job.stages()?;
         let ids = gauss_point_ids(&solver);
         let watched = if snapshots {
             resolve_snapshot_ids(
@@ -334,6 +335,8 @@ impl<'a> Run<'a> {
         }
         if let Some(c) = checkpoint {
             solver.restore(c.solver)?;
+            let at = &stages[(solver.stage() as usize).min(stages.len() - 1)];
+            solver.resume_stage(at.loading.clone(), at.steps)?;
         }
         let (stop, stopped_by) = match stop {
             Stop::Never => (Arc::new(AtomicBool::new(false)), ""),
@@ -362,12 +365,12 @@ impl<'a> Run<'a> {
                     let every = job.output.checkpoint_every;
                     let mut hook =
                         Checkpointer::new(hook, dir, every, job, stop).stop_at(max_steps);
-                    let outcome = solver.run(material, &mut hook);
+                    let outcome = run_stages(&mut solver, &stages, material, &mut hook);
                     (outcome, hook.reached(solver.step()))
                 }
                 _ => {
                     let mut hook = hook;
-                    (solver.run(material, &mut hook), false)
+                    (run_stages(&mut solver, &stages, material, &mut hook), false)
                 }
             }
         };
@@ -400,5 +403,26 @@ impl<'a> Run<'a> {
             steps: solver.step(),
             uncommitted_dem_steps,
         })
+    }
+}
+
+/// Runs the solver's current stage to its end, then every stage after it
+/// ([`Solver::begin_stage`]), each in a `stage` span.
+fn run_stages(
+    solver: &mut Solver,
+    stages: &[SolverStage],
+    material: &mut dyn Material,
+    hook: &mut dyn StepObserver,
+) -> cosdem_fem::Result<()> {
+    loop {
+        let k = solver.stage() as usize;
+        let name = stages.get(k).map_or("", |s| s.name.as_str());
+        let span = tracing::info_span!("stage", stage = k, name);
+        let _enter = span.enter();
+        solver.run(material, hook)?;
+        let Some(next) = stages.get(k + 1) else {
+            return Ok(());
+        };
+        solver.begin_stage(next.loading.clone(), next.steps)?;
     }
 }

@@ -159,6 +159,12 @@ pub fn run_settings(job: &Job) -> RunSettings {
         vtk_every: job.output.vtk_every,
         internal_length: internal_length(job),
         linear_range: job.output.linear_range,
+        curve: job.output.curve.as_ref().map(crate::output::curve_axes::CurveAxes::from),
+        pvd_time: job.pvd_time(),
+        vtk_encoding: match job.output.vtk_format {
+            cosdem_job::VtkFormat::Ascii => crate::output::Encoding::Ascii,
+            cosdem_job::VtkFormat::Binary => crate::output::Encoding::Zlib,
+        },
     }
 }
 

@@ -1,4 +1,6 @@
-//! Boundary conditions and loads, all scaled by the load factor `lambda` in [0, 1].
+//! Boundary conditions and loads, all scaled by the load factor `lambda` in [0, 1] of a
+//! stage: a prescribed dof goes from its value at the start of the stage to its target, a
+//! load follows its [`Ramp`]. A one-stage run starts from zero.
 
 use crate::assembly::{Component, DofMap, Field, GaussData};
 use crate::element::{edge_shape, gauss_1d};
@@ -7,31 +9,43 @@ use crate::mesh::Mesh;
 use std::fmt;
 use std::sync::Arc;
 
-/// A prescribed dof value on a named node set, reached at `lambda = 1` (linear growth).
+/// A prescribed dof value on a named node set, reached at `lambda = 1` (linear growth from
+/// its value at the start of the stage).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Dirichlet {
     /// Node set name.
     pub set: String,
     /// Which component.
     pub component: Component,
-    /// Value at the end of the loading (m or rad).
+    /// Value at the end of the stage (m or rad); with `relative`, the change over the stage.
     pub value: f64,
+    /// `value` is an increment on each dof's value at the start of the stage (an unloading
+    /// is a negative one; 0 holds the dof where it is), not a target.
+    pub relative: bool,
 }
 
 impl Dirichlet {
-    /// `component = value` on `set`.
+    /// `component = value` on `set` at the end of the stage.
     pub fn new(set: &str, component: Component, value: f64) -> Self {
-        Self { set: set.to_string(), component, value }
+        Self { set: set.to_string(), component, value, relative: false }
+    }
+
+    /// `component` of `set` moved by `value` over the stage from where it is.
+    pub fn increment(set: &str, component: Component, value: f64) -> Self {
+        Self { set: set.to_string(), component, value, relative: true }
     }
 }
 
-/// How a load follows the load factor.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+/// How a load follows the load factor of its stage.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Ramp {
     /// Grows with `lambda` (zero at the start, full at the end).
+    #[default]
     Linear,
     /// Full from the first step on (e.g. a confining pressure held while the platens move).
     Constant,
+    /// Full at the start, removed linearly to zero at the end (an unloading).
+    Down,
 }
 
 /// What acts on an edge set.
@@ -54,8 +68,8 @@ pub struct EdgeLoad {
     pub ramp: Ramp,
 }
 
-/// Body force and body couple density `[F_x, F_y, M]` as a function of position, ramped
-/// linearly (`M` is ignored by the Cauchy field).
+/// Body force and body couple density `[F_x, F_y, M]` (N/m^3, N m/m^3) as a function of
+/// position, following [`Loading::body_ramp`] (`M` is ignored by the Cauchy field).
 #[derive(Clone)]
 pub struct BodyLoad(pub Arc<dyn Fn([f64; 2]) -> [f64; 3] + Send + Sync>);
 
@@ -81,6 +95,8 @@ pub struct Loading {
     pub edge_loads: Vec<EdgeLoad>,
     /// Body force and couple.
     pub body: Option<BodyLoad>,
+    /// How the body force follows the load factor (default linear).
+    pub body_ramp: Ramp,
     /// Prescribed values of single dofs `(node, component, value at lambda = 1)`, applied
     /// after the set-based ones (for manufactured solutions and analytical profiles).
     pub nodal_dirichlet: Vec<(usize, Component, f64)>,
@@ -97,12 +113,34 @@ pub struct LoadVectors {
     pub f_linear: Vec<f64>,
     /// External force of the constant loads.
     pub f_constant: Vec<f64>,
+    /// Every dof's value at the start of the stage, from which the prescribed ones move to
+    /// their targets; `None` in the first stage (they start from zero).
+    pub prescribed_start: Option<Vec<f64>>,
 }
 
 impl LoadVectors {
     /// External force at load factor `lambda` (> 0).
     pub fn f_ext(&self, lambda: f64) -> Vec<f64> {
         self.f_linear.iter().zip(&self.f_constant).map(|(a, b)| lambda * a + b).collect()
+    }
+
+    /// Value of prescribed dof `k` at load factor `lambda`: from its start value to its
+    /// target (`lambda * target` in the first stage, as before stages existed).
+    pub fn prescribed_at(&self, k: usize, lambda: f64) -> f64 {
+        let v = self.prescribed_value[k];
+        match &self.prescribed_start {
+            None => lambda * v,
+            Some(start) => start[k] + lambda * (v - start[k]),
+        }
+    }
+}
+
+/// Where a load of the given ramp goes: `(into f_constant, into f_linear)` factors.
+fn ramp_factors(ramp: Ramp) -> (f64, f64) {
+    match ramp {
+        Ramp::Linear => (0.0, 1.0),
+        Ramp::Constant => (1.0, 0.0),
+        Ramp::Down => (1.0, -1.0),
     }
 }
 
@@ -134,8 +172,20 @@ impl Loading {
         Self { dirichlet, ..Default::default() }
     }
 
-    /// Which dofs are prescribed and to what, before the dof map exists.
+    /// Which dofs are prescribed and to what, before the dof map exists (a first stage:
+    /// relative values count from zero).
     pub fn prescribed(&self, mesh: &Mesh, field: Field) -> Result<(Vec<bool>, Vec<f64>)> {
+        self.prescribed_from(mesh, field, None)
+    }
+
+    /// Which dofs are prescribed and to what target, a relative value counting from `start`
+    /// (every dof's value at the start of the stage; zero when `None`).
+    pub fn prescribed_from(
+        &self,
+        mesh: &Mesh,
+        field: Field,
+        start: Option<&[f64]>,
+    ) -> Result<(Vec<bool>, Vec<f64>)> {
         let ndf = field.ndf();
         let mut flag = vec![false; mesh.n_nodes() * ndf];
         let mut value = vec![0.0; mesh.n_nodes() * ndf];
@@ -157,7 +207,10 @@ impl Loading {
             for &n in mesh.node_set(&d.set)? {
                 let k = n * ndf + d.component.offset();
                 flag[k] = true;
-                value[k] = d.value;
+                value[k] = match (d.relative, start) {
+                    (true, Some(u)) => u[k] + d.value,
+                    _ => d.value,
+                };
             }
         }
         for &(n, c, v) in &self.nodal_dirichlet {
@@ -178,18 +231,27 @@ impl Loading {
         Ok((flag, value))
     }
 
-    /// Integrates edge and body loads.
+    /// Integrates edge and body loads (a first stage).
     pub fn vectors(&self, mesh: &Mesh, dofs: &DofMap, gauss: &GaussData) -> Result<LoadVectors> {
-        let (prescribed, prescribed_value) = self.prescribed(mesh, dofs.field)?;
+        self.vectors_from(mesh, dofs, gauss, None)
+    }
+
+    /// Integrates edge and body loads of a stage that starts from the dof values `start`
+    /// (see [`LoadVectors::prescribed_start`]).
+    pub fn vectors_from(
+        &self,
+        mesh: &Mesh,
+        dofs: &DofMap,
+        gauss: &GaussData,
+        start: Option<&[f64]>,
+    ) -> Result<LoadVectors> {
+        let (prescribed, prescribed_value) = self.prescribed_from(mesh, dofs.field, start)?;
         let ndf = dofs.field.ndf();
         let mut f_linear = vec![0.0; dofs.n_dofs()];
         let mut f_constant = vec![0.0; dofs.n_dofs()];
         let (t1, w1) = gauss_1d(3);
         for load in &self.edge_loads {
-            let target = match load.ramp {
-                Ramp::Linear => &mut f_linear,
-                Ramp::Constant => &mut f_constant,
-            };
+            let (fc, fl) = ramp_factors(load.ramp);
             for edge in mesh.edge_set(&load.set)? {
                 let x: Vec<[f64; 2]> = edge.nodes.iter().map(|&n| mesh.nodes[n]).collect();
                 for (t, w) in t1.iter().zip(&w1) {
@@ -204,25 +266,47 @@ impl Loading {
                     };
                     for a in 0..3 {
                         for i in 0..2 {
-                            target[edge.nodes[a] * ndf + i] += n[a] * tr[i] * w;
+                            let f = n[a] * tr[i] * w;
+                            let k = edge.nodes[a] * ndf + i;
+                            // Exactly as before stages for the two old ramps (no 0 * f terms:
+                            // they would turn a -0 into +0).
+                            if fl != 0.0 {
+                                f_linear[k] += fl * f;
+                            }
+                            if fc != 0.0 {
+                                f_constant[k] += fc * f;
+                            }
                         }
                     }
                 }
             }
         }
         if let Some(body) = &self.body {
+            let (fc, fl) = ramp_factors(self.body_ramp);
             for g in 0..gauss.len() {
                 let f = (body.0)(gauss.x[g]);
                 let el = mesh.element_nodes(g / gauss.per_element);
                 for (a, &node) in el.iter().enumerate() {
                     let s = gauss.shape(g)[a] * gauss.weight[g];
                     for c in 0..ndf {
-                        f_linear[node * ndf + c] += s * f[c];
+                        let k = node * ndf + c;
+                        if fl != 0.0 {
+                            f_linear[k] += fl * (s * f[c]);
+                        }
+                        if fc != 0.0 {
+                            f_constant[k] += fc * (s * f[c]);
+                        }
                     }
                 }
             }
         }
-        Ok(LoadVectors { prescribed, prescribed_value, f_linear, f_constant })
+        Ok(LoadVectors {
+            prescribed,
+            prescribed_value,
+            f_linear,
+            f_constant,
+            prescribed_start: start.map(<[f64]>::to_vec),
+        })
     }
 }
 

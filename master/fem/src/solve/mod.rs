@@ -8,6 +8,7 @@ mod observer;
 pub mod secant;
 mod settings;
 mod solver;
+mod stage;
 mod system;
 
 pub use linear::LinearSolver;

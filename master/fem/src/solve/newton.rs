@@ -90,12 +90,11 @@ impl Solver {
         let symmetric = material.is_symmetric();
         let f_ext = self.loads.f_ext(target);
         let du_c: Vec<f64> = self
-            .loads
-            .prescribed_value
+            .u
             .iter()
-            .zip(&self.u)
             .zip(&self.loads.prescribed)
-            .map(|((v, u), &p)| if p { target * v - u } else { 0.0 })
+            .enumerate()
+            .map(|(k, (u, &p))| if p { self.loads.prescribed_at(k, target) - u } else { 0.0 })
             .collect();
         let next_trial = |it: &mut u32| {
             let t = TrialId { step, iteration: *it };

@@ -13,8 +13,13 @@ use std::collections::BTreeMap;
 pub struct StepReport {
     /// Converged step number (1-based; the `step` given to `Material::commit`).
     pub step: u64,
-    /// Load factor reached (1 = full loading).
+    /// Stage of the step (0-based, repetitions of a stage counted; 0 for a one-stage job).
+    pub stage: u32,
+    /// Load factor reached within the stage (1 = the stage's full loading).
     pub load_factor: f64,
+    /// Pseudo-time: stages finished before this step plus its load factor (increasing over
+    /// the whole run; equal to `load_factor` in a one-stage job).
+    pub time: f64,
     /// Load factor increment of this step (after any cuts).
     pub increment: f64,
     /// Newton iterations of the successful attempt (solves after the predictor).

@@ -49,6 +49,11 @@ pub struct SolverState {
     pub gauss_points: Vec<GaussPointState>,
     /// Reactions of the named node sets.
     pub reactions: BTreeMap<String, [f64; 3]>,
+    /// The stage the step belongs to (0-based).
+    pub stage: u32,
+    /// Every dof's value at the start of that stage (`None` in the first stage): what its
+    /// prescribed dofs move from ([`Solver::resume_stage`]).
+    pub stage_start: Option<Vec<f64>>,
 }
 
 /// The whole run's step reports.
@@ -75,6 +80,10 @@ pub struct Solver {
     pub(super) lambda: f64,
     /// Converged steps so far.
     pub(super) step: u64,
+    /// The stage being run (0-based; see [`Solver::begin_stage`]).
+    pub(super) stage: u32,
+    /// The stage start of a restored state, until [`Solver::resume_stage`] takes it.
+    pub(super) saved_stage_start: Option<Vec<f64>>,
     /// Load-factor increment of the next attempt (grows after easy or uncut steps, halves on
     /// cuts).
     pub(super) increment: f64,
@@ -135,6 +144,8 @@ impl Solver {
             loads,
             lambda: 0.0,
             step: 0,
+            stage: 0,
+            saved_stage_start: None,
             increment: first_increment,
             committed: None,
             states,
@@ -201,12 +212,15 @@ impl Solver {
             committed: self.committed.clone(),
             gauss_points: self.states.clone(),
             reactions: self.reactions.clone(),
+            stage: self.stage,
+            stage_start: self.loads.prescribed_start.clone(),
         }
     }
 
     /// Continues from a saved [`SolverState`] of a solver built from the same model and
     /// settings: the following steps are bit-identical to those of the uninterrupted run
-    /// (given the material's committed states of the same step).
+    /// (given the material's committed states of the same step). A state of a later stage
+    /// than the first needs that stage's loading: [`Solver::resume_stage`] after this.
     pub fn restore(&mut self, state: SolverState) -> Result<()> {
         let bad = |field: &'static str, value: usize, expected: usize| Error::InvalidSetting {
             field,
@@ -242,6 +256,8 @@ impl Solver {
         self.committed = state.committed;
         self.states = state.gauss_points;
         self.reactions = state.reactions;
+        self.stage = state.stage;
+        self.saved_stage_start = state.stage_start;
         Ok(())
     }
 
@@ -293,7 +309,9 @@ impl Solver {
                     self.step = step;
                     let report = StepReport {
                         step,
+                        stage: self.stage,
                         load_factor: target,
+                        time: f64::from(self.stage) + target,
                         increment: done,
                         iterations,
                         residuals,

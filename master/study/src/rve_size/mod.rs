@@ -142,6 +142,15 @@ pub fn job_for_size(job: &Job, size: f64, radius: Option<f64>) -> Result<Job> {
             }
             *s = side;
         }
+        PackingSpec::Explicit { .. } | PackingSpec::File { .. } => {
+            return Err(Error::InvalidSetting {
+                field: "material.assembly.packing.kind",
+                value: assembly.packing.kind().into(),
+                reason: "the RVE-size study varies the side of a generated packing (hexagonal \
+                         or random); an explicit packing has a given size"
+                    .into(),
+            });
+        }
     }
     job.validate()?;
     Ok(job)
@@ -204,10 +213,7 @@ fn solver_error(e: RunError) -> Error {
 
 /// The disc radius of a hexagonal packing, the largest of a random one.
 fn largest_radius(packing: &PackingSpec) -> f64 {
-    match packing {
-        PackingSpec::Hexagonal { radius, .. } => *radius,
-        PackingSpec::Random { r_max, radii, .. } => radii.iter().copied().fold(*r_max, f64::max),
-    }
+    packing.largest_radius()
 }
 
 /// Runs the job at one size; `curve` is where its curve is written (if any).

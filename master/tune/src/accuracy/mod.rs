@@ -226,10 +226,7 @@ pub fn cheapest(job: &Job, trade: &Trade) -> Result<Option<Plan>, AccuracyError>
     choice::plan_within(job, trade, &[], f64::INFINITY, f64::INFINITY)
 }
 
-/// `hexagonal` or `random`.
+/// `hexagonal`, `random` or `explicit` (a packing file).
 pub fn packing_kind(p: &PackingSpec) -> &'static str {
-    match p {
-        PackingSpec::Hexagonal { .. } => "hexagonal",
-        PackingSpec::Random { .. } => "random",
-    }
+    p.kind()
 }

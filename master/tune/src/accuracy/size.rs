@@ -7,7 +7,6 @@ use super::choice::reset_knobs;
 use super::report::pct;
 use super::{AccuracyError, PropertyErrors};
 use cosdem_dem::AssemblySpec;
-use cosdem_dem::spec::PackingSpec;
 use serde::{Deserialize, Serialize};
 
 /// Committed RVE-size study fits (`cosdem study rve-size`), each `(name, JSON)` in the format
@@ -88,8 +87,8 @@ pub fn size_fits() -> Result<Vec<SizeFit>, AccuracyError> {
 /// have the same size law.
 pub(crate) fn size_key(a: &AssemblySpec) -> AssemblySpec {
     let mut a = a.clone();
-    match &mut a.packing {
-        PackingSpec::Hexagonal { side, .. } | PackingSpec::Random { side, .. } => *side = 0.0,
+    if let Some(side) = a.packing.side_mut() {
+        *side = 0.0;
     }
     reset_knobs(&mut a, None);
     a
@@ -115,9 +114,7 @@ pub(crate) fn size_report(
     target: f64,
     fits: &[SizeFit],
 ) -> (SizeReport, Option<String>) {
-    let side = match assembly.packing {
-        PackingSpec::Hexagonal { side, .. } | PackingSpec::Random { side, .. } => side,
-    };
+    let side = assembly.packing.region_side();
     let volume = side * side;
     let key = size_key(assembly);
     let Some(fit) = fits.iter().find(|f| size_key(&f.assembly) == key) else {

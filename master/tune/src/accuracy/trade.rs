@@ -64,7 +64,11 @@ impl Trade {
     /// [`RANDOM_TABLE`]).
     pub fn for_packing(packing: &PackingSpec) -> Result<Self, AccuracyError> {
         match packing {
-            PackingSpec::Hexagonal { .. } => Self::measured(),
+            // An explicit packing has no table of its own: its kind differs from this one's,
+            // so the plan falls back to the reference settings.
+            PackingSpec::Hexagonal { .. }
+            | PackingSpec::Explicit { .. }
+            | PackingSpec::File { .. } => Self::measured(),
             PackingSpec::Random { .. } => {
                 let mut t = Self::from_csv(RANDOM_TABLE, RANDOM_TABLE_NAME)?;
                 t.packing = packing_kind(packing).into();

@@ -56,11 +56,8 @@ fn planned_knobs_in_report_order() {
 #[test]
 fn apply_setting_agrees_with_the_variants() {
     let job = quick();
-    let side = |j: &mut Job| match &mut assembly_mut(j).unwrap().packing {
-        PackingSpec::Hexagonal { side, .. } | PackingSpec::Random { side, .. } => {
-            std::mem::replace(side, 0.0)
-        }
-    };
+    let side =
+        |j: &mut Job| std::mem::replace(assembly_mut(j).unwrap().packing.side_mut().unwrap(), 0.0);
     for v in &variants(&job)[2..] {
         let mut j = job.clone();
         apply_setting(&mut j, v.knob, &v.setting).unwrap();

@@ -4,6 +4,7 @@ use crate::broadphase::{self, PairList};
 use crate::contact::Law;
 use crate::error::{Error, Result};
 use crate::integrate::{self, Dynamics, Work, timestep::checked_step};
+use crate::packing::explicit::first_overlap;
 use crate::packing::{Packing, hexagonal, random};
 use crate::spec::{
     AssemblySpec, BoundarySpec, PackingSpec, RelaxationSpec, RollingModel, TangentialModel,
@@ -30,6 +31,25 @@ pub(super) fn new(spec: &AssemblySpec) -> Result<Assembly> {
             let a = random_assembly(&generation, law)?;
             respec(a, spec)
         }
+        PackingSpec::Explicit { x, y, radii, lx, ly } => {
+            let periodic = matches!(spec.boundary, BoundarySpec::Periodic);
+            if periodic && let Some(o) = first_overlap(x, y, radii, *lx, *ly, true) {
+                return Err(crate::error::invalid(
+                    "packing.lx",
+                    format!(
+                        "discs {} and {} overlapping by {:?} across the cell",
+                        o.i, o.j, o.overlap
+                    ),
+                    "two discs overlap through the periodic cell by more than 1e-2 of the smaller radius",
+                ));
+            }
+            let mut a = from_packing(spec, law, Packing::explicit(x, y, radii, *lx, *ly))?;
+            if let BoundarySpec::Penalty { eps_f, eps_c } = spec.boundary {
+                prestress_reference(&mut a, eps_f, eps_c);
+            }
+            Ok(a)
+        }
+        PackingSpec::File { .. } => unreachable!("refused by validate"),
     }
 }
 

@@ -88,7 +88,10 @@ impl Assembly {
         } else {
             return None;
         };
-        Some(extrapolate(st, target, answer, size))
+        let mut response = extrapolate(st, target, answer, size);
+        // The micro-structure answering is the last relaxed one.
+        response.diagnostics.descriptors = Some(self.descriptors(st));
+        Some(response)
     }
 
     /// True when the affine jump of the relaxed state `st` to `target` (each disc's last
@@ -200,6 +203,7 @@ fn extrapolate(st: &State, target: &MacroDeformation, answer: Answer, size: f64)
             answer,
             unrelaxed_increment: size,
             error_bound: bound,
+            descriptors: None,
         },
     }
 }

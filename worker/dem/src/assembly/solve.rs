@@ -75,6 +75,7 @@ impl Assembly {
             sliding_fraction: h.fabric.sliding_fraction,
             rolling_fraction: h.fabric.rolling_fraction,
             wall_seconds: t0.elapsed().as_secs_f64(),
+            descriptors: Some(self.descriptors(&st)),
             ..Default::default()
         };
         // Never NaN on the wire: a non-finite answer is an error of this Gauss point.
@@ -123,6 +124,14 @@ impl Assembly {
     pub fn homogenized(&self, st: &State) -> Homogenized {
         let d = &st.dynamics;
         homogenize(&self.law, &d.x, &d.y, &self.refc.r, &st.pairs, st.target.det() * self.refc.area)
+    }
+
+    /// Micro descriptors of a state (read only: porosity of the current cell `det(Fbar) V`,
+    /// coordination, fabric, sliding, mean rotation; see [`crate::descriptors`]).
+    pub fn descriptors(&self, st: &State) -> cosdem_common::MicroDescriptors {
+        let d = &st.dynamics;
+        let area = st.target.det() * self.refc.area;
+        crate::descriptors::of_state(&self.law, &d.x, &d.y, &self.refc.r, &d.th, &st.pairs, area)
     }
 
     /// Jumps `st` affinely to `target` and relaxes it with tolerance `tol`; with

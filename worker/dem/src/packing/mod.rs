@@ -1,5 +1,9 @@
 //! Reference packings: where the discs are before any macro deformation.
 
+/// A given disc list: its overlap check (the reference state as given).
+pub mod explicit;
+/// Packing files in and out: YADE text and LAMMPS data files.
+pub mod formats;
 /// Dense hexagonal arrangement of equal discs.
 pub mod hexagonal;
 /// Seeded random polydisperse packing at a confining stress.

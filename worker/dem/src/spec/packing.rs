@@ -1,7 +1,11 @@
-//! The reference packing: hexagonal or seeded random, and the cap on the disc count.
+//! The reference packing: hexagonal, seeded random or an explicit disc list (a packing file
+//! read on the master), and the cap on the disc count.
 
 use crate::error::{Result, invalid, positive};
+use crate::packing::explicit::first_overlap;
+use crate::packing::formats::{MIN_DISCS, PackingFormat};
 use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
 
 /// Reference arrangement of the discs.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -33,6 +37,31 @@ pub enum PackingSpec {
         /// Isotropic confining stress magnitude (Pa, compression positive).
         confining_stress: f64,
     },
+    /// An explicit disc list, the reference state as given (no compression, no relaxation
+    /// before the first load; see [`crate::packing::explicit`]). What a `file` packing
+    /// becomes on the master; may also be written out in a job.
+    Explicit {
+        /// Centres x (m), in `[0, lx]` give or take one largest diameter.
+        x: Vec<f64>,
+        /// Centres y (m), in `[0, ly]` give or take one largest diameter.
+        y: Vec<f64>,
+        /// Radii (m), one per centre.
+        radii: Vec<f64>,
+        /// Width of the reference region `[0, lx] x [0, ly]` (m): the square of a penalty
+        /// boundary, the cell of a periodic one.
+        lx: f64,
+        /// Height of the reference region (m).
+        ly: f64,
+    },
+    /// A packing file (YADE text or LAMMPS data), read on the master by the job loader into
+    /// [`PackingSpec::Explicit`] before the job is validated: a worker never reads a file and
+    /// refuses this variant.
+    File {
+        /// The file; relative to the job file.
+        file: PathBuf,
+        /// `yade` or `lammps`.
+        format: PackingFormat,
+    },
 }
 
 impl Default for PackingSpec {
@@ -63,6 +92,57 @@ impl PackingSpec {
                     radii.len() as f64
                 }
             }
+            PackingSpec::Explicit { radii, .. } => radii.len() as f64,
+            PackingSpec::File { .. } => f64::NAN,
+        }
+    }
+
+    /// The packing's kind as the job file names it.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            PackingSpec::Hexagonal { .. } => "hexagonal",
+            PackingSpec::Random { .. } => "random",
+            PackingSpec::Explicit { .. } => "explicit",
+            PackingSpec::File { .. } => "file",
+        }
+    }
+
+    /// The `side` key of a generated packing (hexagonal, random); None for an explicit disc
+    /// list or a file, whose region is given.
+    pub fn side(&self) -> Option<f64> {
+        match self {
+            PackingSpec::Hexagonal { side, .. } | PackingSpec::Random { side, .. } => Some(*side),
+            PackingSpec::Explicit { .. } | PackingSpec::File { .. } => None,
+        }
+    }
+
+    /// The `side` key of a generated packing, to change it (None as for [`Self::side`]).
+    pub fn side_mut(&mut self) -> Option<&mut f64> {
+        match self {
+            PackingSpec::Hexagonal { side, .. } | PackingSpec::Random { side, .. } => Some(side),
+            PackingSpec::Explicit { .. } | PackingSpec::File { .. } => None,
+        }
+    }
+
+    /// Side of the square of the reference region's area (m): `side` for a generated
+    /// packing, `sqrt(lx ly)` for an explicit disc list, NaN for an unread file.
+    pub fn region_side(&self) -> f64 {
+        match self {
+            PackingSpec::Explicit { lx, ly, .. } => (lx * ly).sqrt(),
+            other => other.side().unwrap_or(f64::NAN),
+        }
+    }
+
+    /// The largest radius the packing can hold (m): `radius`, `r_max` or the largest of an
+    /// explicit list; NaN for an unread file.
+    pub fn largest_radius(&self) -> f64 {
+        match self {
+            PackingSpec::Hexagonal { radius, .. } => *radius,
+            PackingSpec::Random { r_max, radii, .. } => {
+                radii.iter().copied().fold(*r_max, f64::max)
+            }
+            PackingSpec::Explicit { radii, .. } => radii.iter().copied().fold(0.0, f64::max),
+            PackingSpec::File { .. } => f64::NAN,
         }
     }
 
@@ -120,22 +200,105 @@ impl PackingSpec {
                     ));
                 }
             }
+            PackingSpec::Explicit { x, y, radii, lx, ly } => {
+                validate_explicit(x, y, radii, *lx, *ly)?;
+                return Ok(());
+            }
+            PackingSpec::File { file, .. } => {
+                return Err(invalid(
+                    "packing.file",
+                    file.display().to_string(),
+                    "a packing file is read on the master when the job is loaded; an assembly \
+                     spec must carry its discs (kind = \"explicit\")",
+                ));
+            }
         }
         let n = self.estimated_discs();
         if n.is_nan() || n > MAX_DISCS as f64 {
             return Err(invalid(
                 "packing.side",
-                format!("{:?} (about {n:.3e} discs)", self.side()),
+                format!("{:?} (about {n:.3e} discs)", self.side().unwrap_or(f64::NAN)),
                 "side / radius too large: more than MAX_DISCS = 1 000 000 discs in one assembly",
             ));
         }
         Ok(())
     }
+}
 
-    /// Side of the reference square (m).
-    fn side(&self) -> f64 {
-        match self {
-            PackingSpec::Hexagonal { side, .. } | PackingSpec::Random { side, .. } => *side,
+/// The checks of an explicit disc list: equal lengths, [`MIN_DISCS`] to [`MAX_DISCS`] discs,
+/// finite centres in the region grown by one largest diameter, radii `> 0`, a region of at least four largest diameters
+/// each way, and no overlap beyond [`crate::packing::explicit::OVERLAP_TOLERANCE`] (inside
+/// the region; across the faces of a periodic cell when the assembly is built). Errors name
+/// the key, the disc's index and the value.
+fn validate_explicit(x: &[f64], y: &[f64], radii: &[f64], lx: f64, ly: f64) -> Result<()> {
+    let n = radii.len();
+    if n > MAX_DISCS {
+        return Err(invalid(
+            "packing.radii",
+            format!("{n} radii"),
+            "more than MAX_DISCS = 1 000 000 discs in one assembly",
+        ));
+    }
+    if n < MIN_DISCS {
+        return Err(invalid("packing.radii", n, "need at least 4 discs"));
+    }
+    if x.len() != n {
+        return Err(invalid(
+            "packing.x",
+            format!("{} centres for {n} radii", x.len()),
+            "one x per radius",
+        ));
+    }
+    if y.len() != n {
+        return Err(invalid(
+            "packing.y",
+            format!("{} centres for {n} radii", y.len()),
+            "one y per radius",
+        ));
+    }
+    positive("packing.lx", lx)?;
+    positive("packing.ly", ly)?;
+    let mut r_max = 0.0f64;
+    for k in 0..n {
+        r_max = r_max.max(radii[k]);
+    }
+    let d = 2.0 * r_max;
+    for k in 0..n {
+        if !(radii[k].is_finite() && radii[k] > 0.0) {
+            return Err(invalid(
+                "packing.radii",
+                format!("radii[{k}] = {:?}", radii[k]),
+                "must be finite and > 0",
+            ));
+        }
+        if !(-d..=lx + d).contains(&x[k]) {
+            return Err(invalid(
+                "packing.x",
+                format!("x[{k}] = {:?}", x[k]),
+                "must be finite and in [-2 r_max, lx + 2 r_max]",
+            ));
+        }
+        if !(-d..=ly + d).contains(&y[k]) {
+            return Err(invalid(
+                "packing.y",
+                format!("y[{k}] = {:?}", y[k]),
+                "must be finite and in [-2 r_max, ly + 2 r_max]",
+            ));
         }
     }
+    if lx.min(ly) < 8.0 * r_max {
+        return Err(invalid(
+            "packing.lx",
+            format!("{lx:?} x {ly:?}"),
+            "the region must be at least four largest diameters (8 r_max) each way",
+        ));
+    }
+    if let Some(o) = first_overlap(x, y, radii, lx, ly, false) {
+        return Err(invalid(
+            "packing.radii",
+            format!("discs {} and {} overlapping by {:?}", o.i, o.j, o.overlap),
+            "two discs overlap by more than 1e-2 of the smaller radius",
+        ));
+    }
+    Ok(())
 }

@@ -41,6 +41,8 @@ impl AssemblySpec {
                     radii.len() as f64
                 }
             }
+            PackingSpec::Explicit { radii, .. } => radii.len() as f64,
+            PackingSpec::File { .. } => f64::NAN,
         };
         saturating_count(n)
     }

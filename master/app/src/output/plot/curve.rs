@@ -88,6 +88,28 @@ pub fn plot_curve(
     title: &str,
     path: &Path,
 ) -> Result<()> {
+    plot_curve_with_labels(curve, metrics, None, title, path)
+}
+
+/// An axis description from a quantity label `"NAME (UNIT)"` with the axis' SI `prefix`:
+/// `"NAME (PREFIXUNIT)"` (`"uy of top (m)"` with `m` gives `"uy of top (mm)"`).
+fn axis_label(label: &str, prefix: &str) -> String {
+    match label.rsplit_once(" (") {
+        Some((name, unit)) => format!("{name} ({prefix}{}", unit),
+        None => label.to_string(),
+    }
+}
+
+/// [`plot_curve`] with the axes of `[output.curve]`: `labels = [abscissa, ordinate]` as
+/// `summary.json`'s `curve_labels` (`"-1 × uy of footing (m)"`); `None`: the compression's
+/// "Displacement d" and "Load F".
+pub fn plot_curve_with_labels(
+    curve: &[(f64, f64)],
+    metrics: &CurveMetrics,
+    labels: Option<&[String; 2]>,
+    title: &str,
+    path: &Path,
+) -> Result<()> {
     register_font();
     if curve.is_empty() {
         return Err(PlotError::NoData { path: path.to_path_buf(), message: "empty curve".into() });
@@ -106,7 +128,12 @@ pub fn plot_curve(
     } else {
         format!("Load-displacement curve: {title}")
     };
-    let mut chart = scales.axes(heading, 24, y0..y1).draw(&root, path)?;
+    let mut axes = scales.axes(heading, 24, y0..y1);
+    if let Some([x, y]) = labels {
+        axes.x_desc = axis_label(x, dprefix);
+        axes.y_desc = axis_label(y, prefix);
+    }
+    let mut chart = axes.draw(&root, path)?;
 
     let scaled = |(d, f): (f64, f64)| (d / dd, f / div);
     let blue = RGBColor(31, 88, 160);
@@ -208,6 +235,14 @@ mod tests {
         let e = plot_curve(&[], &m, "", &dir.join("empty.png")).unwrap_err();
         assert!(e.to_string().contains("empty curve"), "{e}");
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A quantity label takes the axis' SI prefix before its unit.
+    #[test]
+    fn axis_labels_take_the_prefix() {
+        assert_eq!(axis_label("-1 × uy of footing (m)", "m"), "-1 × uy of footing (mm)");
+        assert_eq!(axis_label("R_y of footing (N/m)", "k"), "R_y of footing (kN/m)");
+        assert_eq!(axis_label("plain", "k"), "plain");
     }
 
     #[test]

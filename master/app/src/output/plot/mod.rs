@@ -216,7 +216,9 @@ pub fn plot_run(run: &Path) -> Result<PlotReport> {
         "load-displacement curve".into(),
         curve::read_curve(&curve_path).and_then(|c| {
             let m = read_metrics(run).unwrap_or_else(|| CurveMetrics::from_curve(&c, 0.01));
-            curve::plot_curve(&c, &m, &title, &target).map(|()| target.clone())
+            let labels = read_curve_labels(run);
+            curve::plot_curve_with_labels(&c, &m, labels.as_ref(), &title, &target)
+                .map(|()| target.clone())
         }),
     );
 
@@ -321,6 +323,11 @@ fn read_title(run: &Path) -> String {
     read_summary(run)
         .and_then(|s| s.get("title").and_then(|t| t.as_str()).map(str::to_string))
         .unwrap_or_default()
+}
+
+/// The axis labels of `[output.curve]` (`curve_labels` of `summary.json`), if the run has them.
+fn read_curve_labels(run: &Path) -> Option<[String; 2]> {
+    serde_json::from_value(read_summary(run)?.get("curve_labels")?.clone()).ok()
 }
 
 /// The curve metrics the run itself computed (its linear range), from `summary.json`.

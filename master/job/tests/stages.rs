@@ -1,0 +1,203 @@
+//! `[[stage]]` turned into the solver's stages: what an earlier stage set stays in force
+//! (held dofs, held loads, gravity), paths and repetitions expand, and every bad stage is
+//! refused naming its key and value.
+
+use cosdem_fem::assembly::Component;
+use cosdem_fem::solve::{EdgeLoadKind, Ramp};
+use cosdem_job::{Job, SolverStage};
+
+/// The elastic panel with `stages` (TOML) instead of a `[loading]`.
+fn staged(stages: &str) -> Result<Job, String> {
+    let text = format!(
+        "[mesh]\nkind = \"rectangle\"\nlx = 1.0\nly = 1.0\nnx = 2\nny = 2\n\n\
+         [material]\nkind = \"elastic\"\nshear_modulus = 1e7\npoisson = 0.3\n\n{stages}"
+    );
+    Job::from_toml(&text, "staged.toml").map_err(|e| e.to_string())
+}
+
+fn stages(text: &str) -> Vec<SolverStage> {
+    staged(text).unwrap().stages().unwrap()
+}
+
+/// (set, component, value, relative) of a stage's prescribed dofs.
+fn dirichlet(s: &SolverStage) -> Vec<(String, Component, f64, bool)> {
+    s.loading.dirichlet.iter().map(|d| (d.set.clone(), d.component, d.value, d.relative)).collect()
+}
+
+const LOAD_UNLOAD: &str = r#"
+[[stage]]
+name = "load"
+steps = 4
+prescribed = [
+  { set = "bottom", component = "uy", value = 0.0 },
+  { set = "top", component = "uy", value = -1e-3 },
+]
+
+[[stage]]
+name = "unload"
+steps = 2
+prescribed = [{ set = "top", component = "uy", increment = 5e-4 }]
+
+[[stage]]
+name = "release"
+prescribed = [{ set = "top", component = "uy", free = true }]
+"#;
+
+/// A dof prescribed earlier is held (an increment of 0) until a stage moves or frees it.
+#[test]
+fn prescribed_dofs_are_held_until_moved_or_freed() {
+    let s = stages(LOAD_UNLOAD);
+    assert_eq!(s.len(), 3);
+    assert_eq!((s[0].steps, s[1].steps, s[2].steps), (4, 2, 10));
+    assert_eq!(
+        dirichlet(&s[0]),
+        [("bottom".into(), Component::Uy, 0.0, false), ("top".into(), Component::Uy, -1e-3, false)]
+    );
+    assert_eq!(
+        dirichlet(&s[1]),
+        [("bottom".into(), Component::Uy, 0.0, true), ("top".into(), Component::Uy, 5e-4, true)]
+    );
+    assert_eq!(dirichlet(&s[2]), [("bottom".into(), Component::Uy, 0.0, true)]);
+    // The model is the first stage's.
+    let job = staged(LOAD_UNLOAD).unwrap();
+    assert_eq!(job.model().unwrap().loading.dirichlet.len(), 2);
+    assert_eq!(job.solver_settings().unwrap().steps, 4);
+}
+
+/// A pressure stays at its value in later stages (constant), a new value is reached from
+/// the old one (the old held, the difference ramped), and a removal ramps it down.
+#[test]
+fn pressures_are_held_changed_from_their_value_and_removed() {
+    let s = stages(
+        r#"
+[[stage]]
+prescribed = [{ set = "bottom", component = "uy", value = 0.0 }]
+pressure = [{ set = "left", value = 1e5 }]
+[[stage]]
+prescribed = [{ set = "top", component = "uy", increment = -1e-3 }]
+[[stage]]
+pressure = [{ set = "left", value = 3e5, ramp = "linear" }]
+[[stage]]
+pressure = [{ set = "left", ramp = "remove" }]
+"#,
+    );
+    let edges = |k: usize| -> Vec<(f64, Ramp)> {
+        s[k].loading
+            .edge_loads
+            .iter()
+            .map(|e| match e.kind {
+                EdgeLoadKind::Pressure(p) => (p, e.ramp),
+                EdgeLoadKind::Traction(_) => panic!("no traction here"),
+            })
+            .collect()
+    };
+    assert_eq!(edges(0), [(1e5, Ramp::Constant)]);
+    assert_eq!(edges(1), [(1e5, Ramp::Constant)]);
+    assert_eq!(edges(2), [(1e5, Ramp::Constant), (2e5, Ramp::Linear)]);
+    assert_eq!(edges(3), [(3e5, Ramp::Down)]);
+}
+
+/// A path of targets becomes one stage per target, `repeat` repeats the stage: a cyclic
+/// loading of 2 cycles of (load, unload) is 4 stages with the path's targets in order.
+#[test]
+fn paths_and_repetitions_expand_in_order() {
+    let s = stages(
+        r#"
+[[stage]]
+name = "cycle"
+steps = 3
+repeat = 2
+prescribed = [
+  { set = "bottom", component = "uy", value = 0.0 },
+  { set = "top", component = "uy", path = [-2e-3, -1e-3] },
+]
+"#,
+    );
+    let tops: Vec<f64> = s.iter().map(|x| dirichlet(x)[1].2).collect();
+    assert_eq!(tops, [-2e-3, -1e-3, -2e-3, -1e-3]);
+    assert_eq!(s[3].name, "cycle 2/2 point 2/2");
+    assert!(s.iter().all(|x| x.steps == 3));
+}
+
+/// Gravity: the body force is the density times the acceleration, applied over its stage
+/// (linear) and held after it.
+#[test]
+fn gravity_is_applied_then_held() {
+    let s = stages(
+        r#"
+[[stage]]
+name = "geostatic"
+prescribed = [{ set = "bottom", component = "uy", value = 0.0 }]
+gravity = { acceleration = [0.0, -9.81], density = 2000.0, ramp = "linear" }
+[[stage]]
+prescribed = [{ set = "top", component = "uy", increment = -1e-3 }]
+"#,
+    );
+    for (k, ramp) in [(0, Ramp::Linear), (1, Ramp::Constant)] {
+        let body = s[k].loading.body.as_ref().expect("gravity in force");
+        assert_eq!((body.0)([0.3, 0.7]), [0.0, -19620.0, 0.0]);
+        assert_eq!(s[k].loading.body_ramp, ramp);
+    }
+}
+
+/// A job without `[[stage]]` is the one stage of its `[loading]`.
+#[test]
+fn a_loading_job_is_one_stage() {
+    let job = cosdem_job::fixtures::load("elastic-panel");
+    let s = job.stages().unwrap();
+    assert_eq!(s.len(), 1);
+    assert_eq!(s[0].steps, 4);
+    assert_eq!(s[0].loading.dirichlet, job.loading().dirichlet);
+}
+
+/// Every bad stage is refused naming the key (stages counted from 0) and the value.
+#[test]
+fn bad_stages_are_refused_naming_the_key() {
+    let cases = [
+        ("[[stage]]\nsteps = 0\n", "stage[0].steps", "0"),
+        ("[[stage]]\nrepeat = 0\n", "stage[0].repeat", "0"),
+        (
+            "[[stage]]\nprescribed = [{ set = \"top\", component = \"uy\" }]\n",
+            "stage[0].prescribed[0]",
+            "exactly one of value, increment, path or free",
+        ),
+        (
+            "[[stage]]\nprescribed = [{ set = \"top\", component = \"uy\", value = 1.0, increment = 1.0 }]\n",
+            "stage[0].prescribed[0]",
+            "exactly one",
+        ),
+        (
+            "[[stage]]\n[[stage]]\nprescribed = [{ set = \"top\", component = \"uy\", value = nan }]\n",
+            "stage[1].prescribed[0]",
+            "NaN",
+        ),
+        (
+            "[[stage]]\ngravity = { acceleration = [0.0, -9.81], density = 0.0 }\n",
+            "stage[0].gravity.density",
+            "bulk density",
+        ),
+        ("[loading.compression]\ndisplacement = 0.01\n[[stage]]\n", "loading", "[[stage]]"),
+    ];
+    for (text, key, says) in cases {
+        let e = staged(text).unwrap_err();
+        assert!(e.contains(key) && e.contains(says), "{text}: {e}");
+    }
+}
+
+/// A set the mesh lacks, and a removal of a load never applied, are refused when the
+/// stages are built, naming the key and the value.
+#[test]
+fn unknown_sets_and_removals_of_nothing_are_refused() {
+    let job = staged(
+        "[[stage]]\n[[stage]]\nprescribed = [{ set = \"footing\", component = \"uy\", value = 0.0 }]\n",
+    )
+    .unwrap();
+    let e = job.model().unwrap_err().to_string();
+    assert!(e.contains("stage[1].prescribed[0].set") && e.contains("footing"), "{e}");
+    let job = staged("[[stage]]\npressure = [{ set = \"nosuch\", value = 1.0 }]\n").unwrap();
+    let e = job.model().unwrap_err().to_string();
+    assert!(e.contains("stage[0].pressure[0].set") && e.contains("nosuch"), "{e}");
+    let job = staged("[[stage]]\npressure = [{ set = \"left\", ramp = \"remove\" }]\n").unwrap();
+    let e = job.stages().unwrap_err().to_string();
+    assert!(e.contains("stage[0].pressure[0].set") && e.contains("no earlier stage"), "{e}");
+}
