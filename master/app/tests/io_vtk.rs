@@ -3,9 +3,8 @@
 
 mod io_support;
 
-use cosdem_app::output::vtk::{
-    CellType, DataArray, VtuPiece, gauss_point_piece, nodal_piece, particle_piece, write_vtu,
-};
+use cosdem_app::output::pieces::{gauss_point_piece, nodal_piece, particle_piece};
+use cosdem_app::output::vtk::{CellType, DataArray, VtuPiece, write_vtu};
 use cosdem_app::output::{OutputError, equivalent_strain};
 use cosdem_fem::gmsh::read_msh;
 use io_support::{Element, data, parse, scratch};

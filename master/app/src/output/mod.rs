@@ -20,6 +20,9 @@ pub mod field_data;
 pub mod nodal_stress;
 /// Packing files (YADE, LAMMPS, VTU) of snapshots and of checkpointed assemblies.
 pub mod packing;
+/// VTK XML unstructured grids (`.vtu`): meshes, Gauss-point clouds, particle snapshots.
+/// The pieces written: the mesh with its solution, the Gauss points, a DEM snapshot.
+pub mod pieces;
 /// PNG figures of a run directory (plotters, embedded font): Figs. 3, 9, 10-12.
 pub mod plot;
 /// Where a run's results come from: `provenance.json` and the copy of the job.
@@ -34,7 +37,6 @@ pub mod run_dir;
 pub mod snapshots;
 /// Snapshots and field data written by the run writer at chosen steps.
 pub mod visuals;
-/// VTK XML unstructured grids (`.vtu`): meshes, Gauss-point clouds, particle snapshots.
 pub mod vtk;
 /// zlib-compressed binary arrays of `.vtu` files (`vtkZLibDataCompressor`).
 pub mod vtk_zlib;
@@ -42,11 +44,9 @@ pub mod vtk_zlib;
 pub mod vtu_read;
 
 pub use csv::CsvWriter;
+pub use pieces::{add_micro_descriptors, gauss_point_piece, nodal_piece, particle_piece};
 pub use pvd::{PvdDataset, PvdWriter, read_pvd};
-pub use vtk::{
-    Cell, CellType, DataArray, Encoding, VtuPiece, gauss_point_piece, nodal_piece, particle_piece,
-    write_vtu, write_vtu_encoded,
-};
+pub use vtk::{Cell, CellType, DataArray, Encoding, VtuPiece, write_vtu, write_vtu_encoded};
 
 use std::fmt::Write as _;
 use std::io::Write as _;

@@ -13,10 +13,11 @@
 
 use super::csv::CsvWriter;
 use super::curve_axes::CurveAxes;
+use super::pieces::{add_micro_descriptors, gauss_point_piece, nodal_piece};
 use super::pvd::PvdWriter;
 use super::snapshots::{SnapshotInbox, SnapshotTap};
 use super::visuals::{StepInfo, VisualOutputs, reached as done};
-use super::vtk::{DataArray, gauss_point_piece, nodal_piece, write_vtu_encoded};
+use super::vtk::{DataArray, write_vtu_encoded};
 use super::{OutputError, Result, write_atomic};
 use cosdem_common::Answer;
 use cosdem_common::GaussPointId;
@@ -475,7 +476,7 @@ impl RunWriter {
         let stress: Vec<[f64; 6]> = gp.iter().map(|g| g.stress).collect();
         let mut piece =
             gauss_point_piece(&positions, &strain, &stress, self.settings.internal_length);
-        super::vtk::add_micro_descriptors(&mut piece, gp.iter().map(|g| g.diagnostics.descriptors));
+        add_micro_descriptors(&mut piece, gp.iter().map(|g| g.diagnostics.descriptors));
         piece.time = Some(time);
         let elements: Vec<u32> = gp.iter().map(|g| g.id.element).collect();
         let points: Vec<u32> = gp.iter().map(|g| g.id.point).collect();

@@ -8,7 +8,8 @@
 //! the run writer, called right after the commit, takes it from there when the step is one it
 //! writes. A snapshot that cannot be fetched is logged and skipped: output never stops a run.
 
-use super::vtk::{DataArray, VtuPiece, particle_piece};
+use super::pieces::particle_piece;
+use super::vtk::{DataArray, VtuPiece};
 use super::vtu_read::read_vtu;
 use super::{Result, invalid};
 use cosdem_common::micro::MicroSnapshot;
