@@ -33,8 +33,9 @@ pub enum Error {
         /// What a valid file holds.
         reason: String,
     },
-    /// The explicit integration produced non-finite values.
-    #[error("relaxation diverged after {steps} steps (non-finite state)")]
+    /// The explicit integration produced non-finite values or a runaway spin
+    /// ([`crate::integrate::blown_up`]).
+    #[error("relaxation diverged after {steps} steps (non-finite state or runaway spin)")]
     Diverged {
         /// Steps taken when the blow-up was detected.
         steps: u64,

@@ -3,7 +3,8 @@ use crate::boundary::penalty::boundary_layer;
 use crate::broadphase::{self, PairList};
 use crate::contact::Law;
 use crate::error::{Error, Result};
-use crate::integrate::{self, Dynamics, Work, timestep::checked_step};
+use crate::integrate::timestep::{checked_step, driver_step, stable_penalty_masses};
+use crate::integrate::{self, Dynamics, Work};
 use crate::packing::explicit::first_overlap;
 use crate::packing::{Packing, hexagonal, random};
 use crate::spec::{
@@ -80,7 +81,7 @@ fn respec(mut a: Assembly, spec: &AssemblySpec) -> Result<Assembly> {
     if a.spec == *spec {
         return Ok(a);
     }
-    let (inv_m, inv_i, dt) = inertia(spec, &a.law, &a.refc.r, a.refc.area)?;
+    let (inv_m, inv_i, dt) = inertia(spec, &a.law, &a.refc.r, a.refc.area, &a.refc.boundary)?;
     a.refc.inv_m = inv_m;
     a.refc.inv_i = inv_i;
     a.dt = dt;
@@ -90,12 +91,16 @@ fn respec(mut a: Assembly, spec: &AssemblySpec) -> Result<Assembly> {
 
 /// Inverse masses and moments of inertia of discs of radii `r` (mass scaling applied) and
 /// the relaxation's time step (safety times the critical step of the stiffest oscillator);
-/// an unusable step is an error naming the parameter.
+/// an unusable step is an error naming the parameter. A `boundary` disc whose penalty spring
+/// would make the damped relaxation certainly diverge at that step gets the larger
+/// relaxation mass or inertia of [`stable_penalty_masses`] (none does in a run that was
+/// stable: its masses are unchanged).
 fn inertia(
     spec: &AssemblySpec,
     law: &Law,
     r: &[f64],
     area: f64,
+    boundary: &[u32],
 ) -> Result<(Vec<f64>, Vec<f64>, f64)> {
     let rho = spec.density * spec.relaxation.density_scale;
     let mut inv_m = Vec::with_capacity(r.len());
@@ -113,6 +118,13 @@ fn inertia(
     let m_min = rho * std::f64::consts::PI * r_min * r_min;
     let dt = spec.relaxation.safety
         * checked_step(law, m_min, 0.5 * m_min * r_min * r_min, r_min, kf, kc)?;
+    let (h, gain) = driver_step(&spec.relaxation, dt);
+    for &q in boundary {
+        let q = q as usize;
+        let disc = (1.0 / inv_m[q], 1.0 / inv_i[q], r[q]);
+        let (m, i) = stable_penalty_masses(law, disc, (kf, kc), (h, gain, spec.relaxation.safety));
+        (inv_m[q], inv_i[q]) = (1.0 / m, 1.0 / i);
+    }
     Ok((inv_m, inv_i, dt))
 }
 
@@ -127,7 +139,7 @@ pub(super) fn from_packing(spec: &AssemblySpec, law: Law, p: Packing) -> Result<
         BoundarySpec::Penalty { .. } => boundary_layer(&p.x, &p.y, p.lx, p.ly, 2.0 * r_max),
         BoundarySpec::Periodic => Vec::new(),
     };
-    let (inv_m, inv_i, dt) = inertia(spec, &law, &p.r, area)?;
+    let (inv_m, inv_i, dt) = inertia(spec, &law, &p.r, area, &boundary)?;
     let refc = Reference {
         r: p.r.clone(),
         inv_m,

@@ -16,10 +16,13 @@ use std::time::Instant;
 /// `1 + alpha` while a dof decelerates, which lowers the stable step to `2 / (omega_max
 /// sqrt(1 + alpha))`: 0.77 of it at the default `alpha = 0.7`. The `omega_max` bound counts
 /// six contacts per disc and is loose for contact-dominated assemblies (safety 0.8 was
-/// stable on every committed table), but tight where a penalty spring dominates
-/// (`eps_f = 1e10` diverged at safety 0.8, `worker/tests/extremes.rs`). The retry is
-/// deterministic (same start, same halving), so the answer still depends only on the
-/// committed state and the target.
+/// stable on every committed table), but tight where a penalty spring dominates: there the
+/// boundary disc gets a stable relaxation mass instead
+/// ([`crate::integrate::timestep::stable_penalty_masses`]; `eps_f = 1e10` diverged at safety
+/// 0.8 before, `tests/extremes.rs`), and the retry catches what is left (a dof just inside
+/// that certain-divergence test pushed over by its contacts). The retry is deterministic
+/// (same start, same halving), so the answer still depends only on the committed state and
+/// the target.
 pub const DIVERGENCE_HALVINGS: u32 = 3;
 
 impl Assembly {

@@ -1,5 +1,6 @@
 use crate::contact::Law;
 use crate::error::{Result, invalid};
+use crate::spec::{Driver, FIRE_CEILING, RelaxationSpec};
 
 /// Critical step `2 / omega_max` of the disc system, `omega_max` from a Gershgorin bound on
 /// the mass-normalized stiffness of the smallest disc (mass `m`, inertia `i`, radius `r`)
@@ -98,6 +99,66 @@ pub fn checked_step(law: &Law, m: f64, i: f64, r: f64, kf: f64, kc: f64) -> Resu
     }
 }
 
+/// The largest step a relaxation driver takes with base step `dt`, and the gain its damping
+/// applies to a decelerating force: Cundall's local damping multiplies the force by
+/// `1 + alpha` while a dof moves away from equilibrium, which is every step of leapfrog's
+/// unstable (sign-alternating) mode; FIRE's semi-implicit Euler step has no such gain but
+/// grows to [`crate::spec::FIRE_CEILING`] critical steps.
+pub fn driver_step(spec: &RelaxationSpec, dt: f64) -> (f64, f64) {
+    match spec.driver {
+        Driver::Cundall { alpha } => (dt, 1.0 + alpha),
+        Driver::Fire { dt_max, .. } => ((dt * dt_max).min(FIRE_CEILING * dt / spec.safety), 1.0),
+    }
+}
+
+/// Relaxation mass `m` and moment of inertia `i` of a disc of radius `r` held by the penalty
+/// springs `kf` (N/m) and `kc` (N m/rad), made stable for the step `h` of a driver with
+/// damping gain `gain` (see [`driver_step`]).
+///
+/// Stability. A dof of mass `M` whose own spring is `k` (no cap: the penalty springs are
+/// linear) has `omega_max^2 >= k / M` (Rayleigh quotient of that dof alone), and leapfrog's
+/// sign-alternating mode sees the Cundall gain every step, so it grows when
+/// `gain h^2 omega_max^2 > 4`, i.e. the relaxation certainly diverges when
+/// `h >= 2 / sqrt(gain k / M)`. The Gershgorin step of [`critical_step`] is undamped
+/// (`2 / omega_max`): at safety 0.8 and `alpha = 0.7` it exceeds the damped limit by
+/// `0.8 sqrt(1.7) = 1.04` wherever one penalty term makes up more than 92 % of the bound,
+/// e.g. the moment spring `eps_c / V` on the smallest boundary disc of a small random packing
+/// (`I = m r^2 / 2` falls as `r^4`).
+///
+/// Only such a certainly unstable dof is changed (every other run keeps its bits): its mass
+/// is raised until its Gershgorin row (penalty spring plus six contacts to equal discs, the
+/// rows of [`critical_step`], the couplings kept at the unscaled partner's mass) reaches
+/// `gain h^2 row = 4 safety^2`, the margin the undamped bound gets. The equilibrium a
+/// relaxation reaches does not depend on the masses (as with `relaxation.density_scale`).
+pub fn stable_penalty_masses(
+    law: &Law,
+    (m, i, r): (f64, f64, f64),
+    (kf, kc): (f64, f64),
+    (h, gain, safety): (f64, f64, f64),
+) -> (f64, f64) {
+    const Z: f64 = 6.0;
+    let ks = if law.mu_s > 0.0 { law.ks } else { 0.0 };
+    let kr = if law.mu_r > 0.0 { law.kr } else { 0.0 };
+    let target = 4.0 * safety * safety / (gain * h * h);
+    // Row of a dof of scaled mass M: `diag / M + off / sqrt(M)`; returns the M at `target`.
+    let scaled = |k_pen: f64, mass: f64, diag: f64, off: f64| -> f64 {
+        if gain * h * h * k_pen < 4.0 * mass {
+            return mass;
+        }
+        let (a, b) = (k_pen + Z * diag, Z * off);
+        let u = (-b + b.mul_add(b, 4.0 * a * target).sqrt()) / (2.0 * a);
+        let stable = 1.0 / (u * u);
+        if stable.is_finite() { stable.max(mass) } else { mass }
+    };
+    // Translation: normal (self + partner) or tangential (self + partner + two levers).
+    let (sm, si) = (m.sqrt(), i.sqrt());
+    let m2 = scaled(kf, m, law.kn.max(ks), (law.kn / sm).max(ks / sm + 2.0 * ks * r / si));
+    // Rotation: shear lever and rolling spring (self + partner), two levers to translations.
+    let kt = ks * r * r + kr;
+    let i2 = scaled(kc, i, kt, kt / si + 2.0 * ks * r / sm);
+    (m2, i2)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -132,5 +193,33 @@ mod tests {
             critical_step(&law(6.7e7, 1e300, 0.0, 1e300, 0.0), m, i, r, 0.0, 0.0),
             critical_step(&free, m, i, r, 0.0, 0.0)
         );
+    }
+
+    /// A certainly unstable penalty dof (`gain h^2 k / M >= 4`) gets the mass that puts its
+    /// Gershgorin row at `gain h^2 row = 4 safety^2` (the closed form solves a quadratic in
+    /// `1 / sqrt(M)`: checked by re-evaluating the row, to rounding); any other dof keeps its
+    /// bits, and FIRE (no damping gain, at most 0.9 critical steps) never changes a mass.
+    #[test]
+    fn stable_penalty_masses_only_move_unstable_dofs() {
+        let l = law(6.7e7, 3.4e7, 0.5, 25.0, 0.2);
+        let (r, kf, kc) = (0.002, 2.99e9, 4.46e5);
+        let m = 2650.0 * std::f64::consts::PI * r * r;
+        let i = 0.5 * m * r * r;
+        let dt = 0.8 * critical_step(&l, m, i, r, kf, kc);
+        let (m2, i2) = stable_penalty_masses(&l, (m, i, r), (kf, kc), (dt, 1.7, 0.8));
+        assert_eq!(m2.to_bits(), m.to_bits(), "the force spring is stable at this step");
+        assert!(i2 > i);
+        let (ks, kr) = (3.4e7, 25.0);
+        let row = (kc + 6.0 * (ks * r * r + kr)) / i2
+            + 6.0 * ((ks * r * r + kr) / i.sqrt() + 2.0 * ks * r / m.sqrt()) / i2.sqrt();
+        assert!((1.7 * dt * dt * row / (4.0 * 0.64) - 1.0).abs() < 1e-12, "{row:e}");
+        // Undamped at the same step, or damped at safety 0.5: unchanged.
+        let same =
+            |h: f64, gain: f64| stable_penalty_masses(&l, (m, i, r), (kf, kc), (h, gain, 0.8));
+        assert_eq!(same(dt, 1.0), (m, i));
+        assert_eq!(same(dt * 0.5 / 0.8, 1.7), (m, i));
+        let fire = RelaxationSpec { driver: Driver::fire(), ..RelaxationSpec::default() };
+        let (h, gain) = driver_step(&fire, dt);
+        assert_eq!(same(h, gain), (m, i));
     }
 }
