@@ -31,7 +31,8 @@ pub(crate) enum BenchWhat {
     TradeoffPlot(TradeoffPlotArgs),
     /// Average the sweeps of several specimens (one `bench tradeoff` directory per packing
     /// seed): specimen-mean F_u, F_res and E against the mean of the references, with the
-    /// paired differences' standard errors; writes tradeoff.csv, tradeoff.md and pareto.png.
+    /// paired differences' standard errors; writes tradeoff.csv, tradeoff.md and pareto.png
+    /// (with pareto.svg).
     TradeoffSpecimens(TradeoffSpecimensArgs),
 }
 

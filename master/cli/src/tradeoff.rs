@@ -46,7 +46,8 @@ pub(crate) fn tradeoff_specimens(a: TradeoffSpecimensArgs) -> Result<()> {
 pub(crate) struct TradeoffPlotArgs {
     /// The sweep's CSV (written by `cosdem bench tradeoff`).
     csv: PathBuf,
-    /// The PNG to write (default: pareto.png beside the CSV).
+    /// The PNG to write (default: pareto.png beside the CSV); the SVG goes beside it, same
+    /// name.
     #[arg(long)]
     out: Option<PathBuf>,
     /// The figure's title (default: "Speed against accuracy: <CSV>").

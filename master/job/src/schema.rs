@@ -364,6 +364,32 @@ pub struct OutputSection {
     pub curve: Option<crate::curve::CurveSection>,
     /// Encoding of the `.vtu` files: `ascii` (default) or `binary` (zlib-compressed base64).
     pub vtk_format: VtkFormat,
+    /// Formats (`yade`, `lammps`, `vtu`) in which each particle snapshot of `snapshots` is also
+    /// written as a packing file beside it, `packing_NNNNN.{txt,data,vtu}`; empty: none.
+    #[serde(deserialize_with = "packing_formats", skip_serializing_if = "Vec::is_empty")]
+    pub packing_formats: Vec<cosdem_dem::packing::formats::OutputFormat>,
+}
+
+/// `output.packing_formats`: a list of format names, each known and named once; an error
+/// names the key and the value.
+fn packing_formats<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> Result<Vec<cosdem_dem::packing::formats::OutputFormat>, D::Error> {
+    use serde::de::Error;
+    let names = Vec::<String>::deserialize(d)?;
+    let mut formats = Vec::with_capacity(names.len());
+    for (i, name) in names.iter().enumerate() {
+        let f = name
+            .parse()
+            .map_err(|e: String| D::Error::custom(format!("`output.packing_formats[{i}]`: {e}")))?;
+        if formats.contains(&f) {
+            return Err(D::Error::custom(format!(
+                "`output.packing_formats[{i}]`: {name:?} is named twice"
+            )));
+        }
+        formats.push(f);
+    }
+    Ok(formats)
 }
 
 /// `[output] vtk_format`.
@@ -391,6 +417,7 @@ impl Default for OutputSection {
             linear_range: PAPER_LINEAR_RANGE,
             curve: None,
             vtk_format: VtkFormat::Ascii,
+            packing_formats: Vec::new(),
         }
     }
 }

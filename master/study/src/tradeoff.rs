@@ -77,19 +77,20 @@ pub fn pareto_panels(rows: &[Row]) -> Vec<ParetoPanel> {
     panels
 }
 
-/// Draws the Pareto plot of a sweep (see [`pareto_panels`]) into `path` (PNG).
+/// Draws the Pareto plot of a sweep (see [`pareto_panels`]) into `path` (PNG) and the SVG
+/// beside it (same name).
 pub fn write_pareto(rows: &[Row], title: &str, path: &std::path::Path) -> PlotResult<()> {
     plot_pareto(&pareto_panels(rows), title, path)
 }
 
-/// The Pareto plot's file name in a sweep's directory.
+/// The Pareto plot's file name in a sweep's directory (its SVG: `pareto.svg`).
 pub const PARETO_FILE: &str = "pareto.png";
 
 /// Runs the sweep of `base` into `out` (one run directory per variant under `out/runs/`),
-/// rewriting `out/tradeoff.csv`, `out/tradeoff.md` and `out/pareto.png` after every run so a
-/// long sweep can be read as it goes. `progress` hears each finished row. The reference runs
-/// first. The job's `accuracy` key, if any, is dropped: it would move the very knobs the
-/// sweep measures.
+/// rewriting `out/tradeoff.csv`, `out/tradeoff.md` and `out/pareto.png` (and `.svg`) after
+/// every run so a long sweep can be read as it goes. `progress` hears each finished row. The
+/// reference runs first. The job's `accuracy` key, if any, is dropped: it would move the very
+/// knobs the sweep measures.
 ///
 /// After the one-knob rows, a DEM job gets the rows that move several knobs at once, planned
 /// from this sweep's own rows by [`cosdem_tune::accuracy`]: `accuracy` 0.05, 0.1 and 0.2 (what

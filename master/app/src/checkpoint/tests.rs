@@ -45,6 +45,7 @@ fn settings(job: &Job) -> RunSettings {
         curve: None,
         pvd_time: crate::output::run_dir::PvdTime::Displacement,
         vtk_encoding: crate::output::Encoding::Ascii,
+        packings: Default::default(),
     }
 }
 

@@ -4,16 +4,17 @@
 //! for ParaView's glyphs).
 //!
 //! Two sources: a particle snapshot of a run (`[output] packing_formats`, written beside the
-//! snapshot: it carries no region, so the region is the discs' bounding box and the centres
-//! are shifted to it, see [`super::snapshots::snapshot_packing`]) and an assembly's committed
-//! state in a checkpoint ([`Packing::committed`]: the reference region mapped by the committed
-//! macro deformation).
+//! snapshot as `packing_NNNNN.{txt,data,vtu}` ([`snapshot_packing_path`]): it carries no
+//! region, so the region is the discs' bounding box and the centres are shifted to it, see
+//! [`super::snapshots::snapshot_packing`]) and an assembly's committed state in a checkpoint
+//! ([`Packing::committed`]: the reference region mapped by the committed macro deformation).
 
 use super::vtk::{DataArray, Encoding, VtuPiece, write_vtu_encoded};
 use super::{Result, io_err, write_atomic};
 use cosdem_common::GaussPointId;
 use cosdem_dem::packing::Packing;
 use cosdem_dem::packing::formats::{OutputFormat, write_lammps, write_yade};
+use cosdem_job::{Job, MaterialSection};
 use std::path::{Path, PathBuf};
 
 /// The VTU piece of a packing: the centres (z = 0) as vertices with `radius`.
@@ -31,6 +32,33 @@ pub fn write_packing(path: &Path, p: &Packing, density: f64, format: OutputForma
         OutputFormat::Lammps => write_atomic(path, write_lammps(p, density).as_bytes()),
         OutputFormat::Vtu => write_vtu_encoded(path, &packing_piece(p), Encoding::Ascii),
     }
+}
+
+/// `[output] packing_formats` of a run: the formats each particle snapshot is also written in,
+/// and the solid density (kg/m^3) a LAMMPS file carries.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct PackingOutput {
+    /// The formats, in the job's order (empty: no packing files).
+    pub formats: Vec<OutputFormat>,
+    /// The assemblies' density (the DEM spec's; the spec's default for a job without discs).
+    pub density: f64,
+}
+
+impl PackingOutput {
+    /// The packing files `job` asks for.
+    pub fn of(job: &Job) -> Self {
+        let density = match &job.material {
+            MaterialSection::Dem { assembly } => assembly.density,
+            MaterialSection::Elastic { .. } => cosdem_dem::AssemblySpec::default().density,
+        };
+        Self { formats: job.output.packing_formats.clone(), density }
+    }
+}
+
+/// The packing file of the snapshot of `step` in its series directory `dir`
+/// (`dir/packing_NNNNN.{txt,data,vtu}`, beside `snap_NNNNN.vtu`).
+pub fn snapshot_packing_path(dir: &Path, step: u64, format: OutputFormat) -> PathBuf {
+    dir.join(format!("packing_{step:05}.{}", format.extension()))
 }
 
 /// The file of Gauss point `id`'s packing in `dir` (`e{E}_p{P}.{txt,data,vtu}`), the name

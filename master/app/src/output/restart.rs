@@ -76,6 +76,10 @@ pub fn cut_back(dir: &Path, step: u64, displacement: &[f64], vtk: bool) -> Resul
         names.sort();
         for name in names {
             let kept = keep_up_to(&snapshots.join(&name), "snap", "vtu", step)?;
+            // The packing files of `[output] packing_formats` beside the snapshots.
+            for ext in ["txt", "data", "vtu"] {
+                keep_up_to(&snapshots.join(&name), "packing", ext, step)?;
+            }
             rebuild(&snapshots.join(format!("{name}.pvd")), &kept, displacement)?;
         }
     }

@@ -69,6 +69,8 @@ pub struct RunSettings {
     pub pvd_time: PvdTime,
     /// Encoding of the `.vtu` files.
     pub vtk_encoding: super::Encoding,
+    /// `[output] packing_formats`: packing files written with each particle snapshot.
+    pub packings: super::packing::PackingOutput,
 }
 
 impl RunSettings {
@@ -413,7 +415,8 @@ impl RunWriter {
         let reached = if self.summary.steps > 0 { self.summary.displacement } else { f64::MIN };
         let pending: Vec<f64> =
             field_plots_at.iter().copied().filter(|&d| !done(reached, d)).collect();
-        self.visuals = VisualOutputs::new(snapshots.clone(), &pending, inbox.clone());
+        self.visuals = VisualOutputs::new(snapshots.clone(), &pending, inbox.clone())
+            .with_packings(self.settings.packings.clone());
         SnapshotTap::new(material, snapshots, inbox)
     }
 

@@ -1,6 +1,6 @@
 //! Particle snapshots of chosen Gauss points: fetched from the material after every commit
-//! ([`SnapshotTap`]), written as VTK ([`snapshot_piece`]) and read back for plots
-//! ([`read_snapshot`]).
+//! ([`SnapshotTap`]), written as VTK ([`snapshot_piece`]) and as packing files
+//! ([`snapshot_packing`]), and read back for plots ([`read_snapshot`]).
 //!
 //! The solver hands its observers the FE solution only, so the snapshots are taken by a thin
 //! [`Material`] wrapper: after the wrapped material commits step N it asks it for the particle
@@ -14,6 +14,7 @@ use super::vtu_read::read_vtu;
 use super::{Result, invalid};
 use cosdem_common::micro::MicroSnapshot;
 use cosdem_common::{GaussPointId, MicroResponse};
+use cosdem_dem::packing::Packing;
 use cosdem_fem::material::{Material, MaterialError, MaterialInput, TrialId};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -213,6 +214,24 @@ pub fn snapshot_piece(s: &ParticleSnapshot) -> VtuPiece {
     piece.add_cell_data(DataArray::scalars("tangential_force", ft));
     piece.time = s.displacement;
     piece
+}
+
+/// The discs of a snapshot as a packing: the region is the discs' bounding box
+/// (`min(x - r)` to `max(x + r)`, the region a packing reader gives a file without one) and
+/// the centres are shifted by `(-min(x - r), -min(y - r))`, so that the region starts at the
+/// origin as the readers' does. Discs keep their order.
+pub fn snapshot_packing(s: &ParticleSnapshot) -> Packing {
+    let mut b = [f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY];
+    for (c, r) in s.centres.iter().zip(&s.radius) {
+        b = [b[0].min(c[0] - r), b[1].max(c[0] + r), b[2].min(c[1] - r), b[3].max(c[1] + r)];
+    }
+    Packing {
+        x: s.centres.iter().map(|c| c[0] - b[0]).collect(),
+        y: s.centres.iter().map(|c| c[1] - b[2]).collect(),
+        r: s.radius.clone(),
+        lx: b[1] - b[0],
+        ly: b[3] - b[2],
+    }
 }
 
 /// Reads a snapshot `.vtu` written from [`snapshot_piece`].

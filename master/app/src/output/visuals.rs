@@ -4,15 +4,21 @@
 //! ```text
 //! RUN/snapshots/e{E}_p{P}.pvd                 ParaView series of one Gauss point's assembly
 //! RUN/snapshots/e{E}_p{P}/snap_NNNNN.vtu      discs (radius, rotation, fluctuation) + contacts
+//! RUN/snapshots/e{E}_p{P}/packing_NNNNN.txt   the same discs as YADE text      ┐ `[output]
+//! RUN/snapshots/e{E}_p{P}/packing_NNNNN.data  ... as a LAMMPS data file        │ packing_
+//! RUN/snapshots/e{E}_p{P}/packing_NNNNN.vtu   ... as a VTU point cloud         ┘ formats`
 //! RUN/fields/field_NNNNN.json                 mesh, u and equivalent strain (Eq. 34) of a step
 //! ```
 //! Snapshots are written at the VTK cadence (`vtk_every`), at the first step reaching each
 //! `field_plots_at` displacement and at the last step; field data at those displacements and
-//! at the last step. Every file is written atomically and the `.pvd` lists only written files.
+//! at the last step; the packing files with every snapshot, in the formats asked
+//! ([`super::packing`], the same files as `cosdem export`'s, of the snapshot's discs). Every
+//! file is written atomically and the `.pvd` lists only written files.
 
 use super::field_data::FieldData;
+use super::packing::{PackingOutput, snapshot_packing_path, write_packing};
 use super::pvd::PvdWriter;
-use super::snapshots::{ParticleSnapshot, SnapshotInbox, snapshot_piece};
+use super::snapshots::{ParticleSnapshot, SnapshotInbox, snapshot_packing, snapshot_piece};
 use super::{Result, io_err, write_vtu};
 use cosdem_common::GaussPointId;
 use cosdem_fem::solve::SolutionView;
@@ -27,6 +33,8 @@ pub struct VisualOutputs {
     series: BTreeMap<GaussPointId, PvdWriter>,
     /// `field_plots_at` displacements not reached yet, ascending.
     pending: Vec<f64>,
+    /// The packing files written with each snapshot.
+    packings: PackingOutput,
 }
 
 /// What [`VisualOutputs::on_step`] needs to know about the step.
@@ -66,7 +74,13 @@ impl VisualOutputs {
     ) -> Self {
         let mut pending: Vec<f64> = field_plots_at.to_vec();
         pending.sort_by(f64::total_cmp);
-        Self { snapshot_ids, inbox, series: BTreeMap::new(), pending }
+        Self { snapshot_ids, inbox, series: BTreeMap::new(), pending, packings: Default::default() }
+    }
+
+    /// Also writes each snapshot as packing files in `packings.formats`.
+    pub fn with_packings(mut self, packings: PackingOutput) -> Self {
+        self.packings = packings;
+        self
     }
 
     /// Writes what the step calls for into `dir`.
@@ -147,6 +161,13 @@ impl VisualOutputs {
             }
         };
         write_vtu(&path, &snapshot_piece(&particles))?;
+        if !self.packings.formats.is_empty() {
+            let packing = snapshot_packing(&particles);
+            for &format in &self.packings.formats {
+                let file = snapshot_packing_path(&sub, s.step, format);
+                write_packing(&file, &packing, self.packings.density, format)?;
+            }
+        }
         pvd.add(s.time, &path)
     }
 }

@@ -165,6 +165,7 @@ pub fn run_settings(job: &Job) -> RunSettings {
             cosdem_job::VtkFormat::Ascii => crate::output::Encoding::Ascii,
             cosdem_job::VtkFormat::Binary => crate::output::Encoding::Zlib,
         },
+        packings: crate::output::packing::PackingOutput::of(job),
     }
 }
 

@@ -6,7 +6,7 @@
 //! into panels. Labels are placed by [`place_labels`], a greedy search for a free spot next to
 //! each point (sweeps put many points on top of each other: settings that change nothing).
 
-use cosdem_app::output::plot::{DrawResult, FONT, PlotError, Result, register_font};
+use cosdem_app::output::plot::{Draw, DrawResult, FONT, Figure, PlotError, Result, write_figure};
 use plotters::prelude::*;
 use std::path::Path;
 
@@ -149,29 +149,41 @@ fn decade_tick(v: f64) -> String {
     }
 }
 
-/// Draws the panels side by side into `path` (PNG) under `title`. Errors of 0 (the
+/// Draws the panels side by side into `path` (PNG, and the same as SVG beside it) under
+/// `title`. Errors of 0 (the
 /// reference) cannot sit on a log axis: they are drawn on the axis floor and say so in the
 /// legend.
 pub fn plot_pareto(panels: &[ParetoPanel], title: &str, path: &Path) -> Result<()> {
-    register_font();
     if panels.iter().all(|p| p.points.is_empty()) {
         return Err(PlotError::NoData { path: path.to_path_buf(), message: "no rows".into() });
     }
-    let n = panels.len().max(1) as u32;
-    let root = BitMapBackend::new(path, (PANEL.0 * n, PANEL.1)).into_drawing_area();
-    root.fill(&WHITE).at(path)?;
-    let root = root.titled(title, (FONT, 26)).at(path)?;
-    let areas = root.split_evenly((1, panels.len().max(1)));
-    for (panel, area) in panels.iter().zip(&areas) {
-        draw_panel(panel, area, path)?;
-    }
-    root.present().at(path)?;
-    Ok(())
+    write_figure(&ParetoFigure { panels, title }, path)
 }
 
-fn draw_panel(
+/// The Pareto figure's drawing: its panels side by side under the title.
+struct ParetoFigure<'p> {
+    panels: &'p [ParetoPanel],
+    title: &'p str,
+}
+
+impl Draw for ParetoFigure<'_> {
+    fn size(&self) -> (u32, u32) {
+        (PANEL.0 * self.panels.len().max(1) as u32, PANEL.1)
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &Figure<DB>, path: &Path) -> Result<()> {
+        let root = root.titled(self.title, (FONT, 26)).at(path)?;
+        let areas = root.split_evenly((1, self.panels.len().max(1)));
+        for (panel, area) in self.panels.iter().zip(&areas) {
+            draw_panel(panel, area, path)?;
+        }
+        Ok(())
+    }
+}
+
+fn draw_panel<DB: DrawingBackend>(
     panel: &ParetoPanel,
-    area: &DrawingArea<BitMapBackend<'_>, plotters::coord::Shift>,
+    area: &Figure<DB>,
     path: &Path,
 ) -> Result<()> {
     // Percent; zero errors go to the floor.

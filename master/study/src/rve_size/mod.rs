@@ -407,8 +407,9 @@ type Property<'a> = (&'a str, &'a str, &'a str, &'a FitOutcome, fn(&CurveMetrics
 
 /// Draws the study's figures into `dir/plots/`: `curves.png` (every size's load-displacement
 /// curve, Fig. 3) and `size_<property>.png` (F_u, F_res, E, E50 against V with the fitted law,
-/// Figs. 4-5). Returns the figures that could not be drawn (a property without values, e.g.
-/// no F_res before a peak) with why; none of them stops the study.
+/// Figs. 4-5), each with its SVG beside it (same name). Returns the figures that could not be
+/// drawn (a property without values, e.g. no F_res before a peak) with why; none of them
+/// stops the study.
 pub fn plot_study(
     study: &RveSizeStudy,
     dir: &Path,

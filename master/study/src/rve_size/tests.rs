@@ -56,7 +56,22 @@ fn three_tiny_sizes_run_deterministically_and_write_files() {
         "plots/size_stiffness.png",
     ] {
         assert!(d1.join(f).is_file(), "{f}");
+        if let Some(png) = f.strip_suffix(".png") {
+            // The same figure as SVG beside it: a whole document.
+            let svg = std::fs::read_to_string(d1.join(format!("{png}.svg"))).unwrap();
+            assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"), "{png}.svg");
+        }
     }
+    // The curves' figure: one polyline per size (plus its legend stroke) through the origin
+    // and every step of the size's curve (2 steps).
+    let svg = std::fs::read_to_string(d1.join("plots/curves.svg")).unwrap();
+    let points: Vec<usize> = svg
+        .lines()
+        .filter(|l| l.starts_with("<polyline") && l.contains("stroke-width=\"2\""))
+        .filter_map(|l| l.split("points=\"").nth(1)?.split('"').next())
+        .map(|p| p.split_whitespace().count())
+        .collect();
+    assert_eq!(points, vec![3; 3], "{points:?}");
     let csv = std::fs::read_to_string(d1.join("study.csv")).unwrap();
     assert_eq!(csv.lines().count(), 4);
     let curve = std::fs::read_to_string(d1.join("curves/curve_0.0025.csv")).unwrap();

@@ -185,6 +185,10 @@ fn pareto_plot_of_a_committed_sweep() {
     let img = image::open(&path).unwrap().to_rgb8();
     let ink = img.pixels().filter(|p| p.0 != [255, 255, 255]).count();
     assert!(ink > 10_000, "only {ink} non-white pixels");
+    // The same figure as SVG beside it, as wide as the PNG (two panels).
+    let svg = std::fs::read_to_string(dir.join("pareto.svg")).unwrap();
+    assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+    assert!(svg.contains(&format!("width=\"{}\"", img.width())), "{}", &svg[..120]);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -1,6 +1,6 @@
 use super::{
-    DrawResult, LineAxes, PlotError, Result, blank_figure, draw_legend, register_font, si_prefix,
-    sig4,
+    Draw, DrawResult, Figure, LineAxes, PlotError, Result, draw_legend, si_prefix, sig4,
+    write_figure,
 };
 use crate::output::io_err;
 use cosdem_fem::post::CurveMetrics;
@@ -102,7 +102,7 @@ fn axis_label(label: &str, prefix: &str) -> String {
 
 /// [`plot_curve`] with the axes of `[output.curve]`: `labels = [abscissa, ordinate]` as
 /// `summary.json`'s `curve_labels` (`"-1 × uy of footing (m)"`); `None`: the compression's
-/// "Displacement d" and "Load F".
+/// "Displacement d" and "Load F". Written as the PNG `path` and the SVG beside it.
 pub fn plot_curve_with_labels(
     curve: &[(f64, f64)],
     metrics: &CurveMetrics,
@@ -110,19 +110,43 @@ pub fn plot_curve_with_labels(
     title: &str,
     path: &Path,
 ) -> Result<()> {
-    register_font();
     if curve.is_empty() {
         return Err(PlotError::NoData { path: path.to_path_buf(), message: "empty curve".into() });
     }
     let points: Vec<(f64, f64)> =
         std::iter::once((0.0, 0.0)).chain(curve.iter().copied()).collect();
+    write_figure(&CurveFigure { points, metrics, labels, title }, path)
+}
+
+/// Fig. 3's drawing: the curve's points from the origin, its metrics, axis labels and title.
+struct CurveFigure<'c> {
+    points: Vec<(f64, f64)>,
+    metrics: &'c CurveMetrics,
+    labels: Option<&'c [String; 2]>,
+    title: &'c str,
+}
+
+impl Draw for CurveFigure<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &Figure<DB>, path: &Path) -> Result<()> {
+        let CurveFigure { points, metrics, labels, title } = self;
+        draw_curve(root, points, metrics, *labels, title, path)
+    }
+}
+
+fn draw_curve<DB: DrawingBackend>(
+    root: &Figure<DB>,
+    points: &[(f64, f64)],
+    metrics: &CurveMetrics,
+    labels: Option<&[String; 2]>,
+    title: &str,
+    path: &Path,
+) -> Result<()> {
     let scales = LoadScales::of(points.iter().copied());
     let LoadScales { dmax, fmax, fmin, div, prefix, dd, dprefix } = scales;
     let y1 = (fmax / div) * 1.12;
     let y1 = if y1 > 0.0 { y1 } else { 1.0 };
     let y0 = (fmin / div).min(0.0) * 1.12;
 
-    let root = blank_figure(path)?;
     let heading = if title.is_empty() {
         "Load-displacement curve".to_string()
     } else {
@@ -133,7 +157,7 @@ pub fn plot_curve_with_labels(
         axes.x_desc = axis_label(x, dprefix);
         axes.y_desc = axis_label(y, prefix);
     }
-    let mut chart = axes.draw(&root, path)?;
+    let mut chart = axes.draw(root, path)?;
 
     let scaled = |(d, f): (f64, f64)| (d / dd, f / div);
     let blue = RGBColor(31, 88, 160);
@@ -202,15 +226,18 @@ pub fn plot_curve_with_labels(
                 PathElement::new(vec![(x, y), (x + 24, y)], orange.stroke_width(2))
             });
     }
-    draw_legend(&mut chart, SeriesLabelPosition::LowerRight, 18, path)?;
-    root.present().at(path)?;
-    Ok(())
+    draw_legend(&mut chart, SeriesLabelPosition::LowerRight, 18, path)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::output::plot::SIZE;
+
+    /// The point counts of the polylines in the curve's blue.
+    fn svg_check_polylines(svg: &str) -> Vec<usize> {
+        crate::output::plot::svg_check::polylines(svg, "#1F58A0")
+    }
 
     /// A known softening curve is drawn at the figure size with many non-white pixels, and
     /// the blue of the curve is among them.
@@ -232,6 +259,11 @@ mod tests {
         let ink = img.pixels().filter(|p| p.0 != [255, 255, 255]).count();
         assert!(ink > 5_000, "only {ink} non-white pixels");
         assert!(img.pixels().any(|p| p.0 == [31, 88, 160]), "no curve colour");
+        // The SVG beside it: the same curve as one polyline through the origin and every
+        // point (then the legend's two-point stroke), and its text as elements.
+        let svg = crate::output::plot::svg_check::read_beside(&path);
+        assert_eq!(svg_check_polylines(&svg), vec![curve.len() + 1, 2]);
+        assert!(svg.contains(">\nLoad-displacement curve: test\n</text>"), "no caption");
         let e = plot_curve(&[], &m, "", &dir.join("empty.png")).unwrap_err();
         assert!(e.to_string().contains("empty curve"), "{e}");
         std::fs::remove_dir_all(&dir).unwrap();

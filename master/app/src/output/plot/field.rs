@@ -1,5 +1,5 @@
 use super::{
-    DrawResult, FONT, PlotError, Result, SIZE, equal_aspect, register_font, sig4, viridis,
+    Draw, DrawResult, FONT, Figure, PlotError, Result, equal_aspect, sig4, viridis, write_figure,
 };
 use crate::output::field_data::FieldData;
 use cosdem_fem::element::{ElementKind, gauss_1d};
@@ -65,7 +65,6 @@ fn interpolate(f: &FieldData, e: usize, values: &[f64], xi: [f64; 2]) -> ([f64; 
 /// Fig. 9: the equivalent strain (Eq. 34) painted over the deformed mesh (true scale), with
 /// the element edges, the undeformed outline and a colour bar.
 pub fn plot_strain_field(f: &FieldData, title: &str, path: &Path) -> Result<()> {
-    register_font();
     if f.elements.is_empty() {
         return Err(PlotError::NoData { path: path.to_path_buf(), message: "no elements".into() });
     }
@@ -79,8 +78,6 @@ pub fn plot_strain_field(f: &FieldData, title: &str, path: &Path) -> Result<()> 
         (0.0, if hi > 0.0 { hi } else { 1e-12 })
     };
 
-    let root = BitMapBackend::new(path, SIZE).into_drawing_area();
-    root.fill(&WHITE).at(path)?;
     let mut heading = format!(
         "Equivalent strain q (Eq. 34) at d = {} mm (step {}), deformed mesh at true scale",
         sig4(f.displacement * 1e3),
@@ -89,16 +86,28 @@ pub fn plot_strain_field(f: &FieldData, title: &str, path: &Path) -> Result<()> 
     if !title.is_empty() {
         heading = format!("{title}\n{heading}");
     }
-    let mut area = root.clone();
-    for line in heading.lines() {
-        area = area.titled(line, (FONT, 22)).at(path)?;
+    write_figure(&FieldFigure { f, values, range, heading }, path)
+}
+
+/// Fig. 9's drawing: the field, its nodal values, the colour range and the heading.
+struct FieldFigure<'f> {
+    f: &'f FieldData,
+    values: Vec<f64>,
+    range: (f64, f64),
+    heading: String,
+}
+
+impl Draw for FieldFigure<'_> {
+    fn draw<DB: DrawingBackend>(&self, root: &Figure<DB>, path: &Path) -> Result<()> {
+        let mut area = root.clone();
+        for line in self.heading.lines() {
+            area = area.titled(line, (FONT, 22)).at(path)?;
+        }
+        let (w, _) = area.dim_in_pixel();
+        let (main, bar) = area.split_horizontally(w - 170);
+        draw_mesh(&main, self.f, &self.values, self.range, path)?;
+        draw_colour_bar(&bar, self.range, path)
     }
-    let (w, _) = area.dim_in_pixel();
-    let (main, bar) = area.split_horizontally(w - 170);
-    draw_mesh(&main, f, &values, range, path)?;
-    draw_colour_bar(&bar, range, path)?;
-    root.present().at(path)?;
-    Ok(())
 }
 
 fn draw_mesh<DB: DrawingBackend>(
@@ -230,6 +239,7 @@ fn draw_colour_bar<DB: DrawingBackend>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::output::plot::SIZE;
 
     fn sample(q: impl Fn([f64; 2]) -> f64) -> FieldData {
         let mesh =
@@ -284,6 +294,10 @@ mod tests {
         assert!(has(viridis(1.0 - 0.5 / 256.0)), "no peak colour");
         let ink = img.pixels().filter(|p| p.0 != [255, 255, 255]).count();
         assert!(ink > 100_000, "{ink}");
+        let svg = crate::output::plot::svg_check::read_beside(&path);
+        // 4 elements of 24 x 24 painted cells, and the 256 bands of the colour bar.
+        assert!(svg.matches("<polygon").count() >= 4 * 24 * 24, "too few cells");
+        assert!(svg.matches("<rect").count() >= 256, "no colour bar");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -1,5 +1,5 @@
-//! PNG figures of a run, drawn from what the run directory holds (so `cosdem plot RUN` can
-//! redraw them at any time):
+//! Figures of a run, drawn from what the run directory holds (so `cosdem plot RUN` can
+//! redraw them at any time), each as a PNG and, beside it with the same name, as an SVG:
 //!
 //! | file in `RUN/plots/` | from | paper |
 //! |---|---|---|
@@ -18,8 +18,12 @@
 //! ([`blank_figure`](crate::output::plot::blank_figure)), axes
 //! ([`LineAxes`](crate::output::plot::LineAxes)) and legend box
 //! ([`draw_legend`](crate::output::plot::draw_legend)).
-//! Drawing uses plotters' bitmap backend with a font embedded in the crate (a subset of
-//! DejaVu Sans, `assets/fonts`), so no system font library is needed.
+//! Every figure is one drawing ([`Draw`], generic over plotters' backends) that
+//! [`write_figure`] sends through the bitmap backend (the PNG) and the SVG backend (the
+//! `.svg` beside it, [`svg_path`]). The bitmap's text is rendered with a font embedded in the
+//! crate (a subset of DejaVu Sans, `assets/fonts`), so no system font library is needed; the
+//! SVG holds its text as `<text>` elements of the generic family `sans-serif` (the embedded
+//! font only measures them, for the layout), so it needs no font file either.
 
 /// Fig. 3: the load-displacement curve.
 pub mod curve;
@@ -98,21 +102,53 @@ impl<T, E: std::fmt::Display> DrawResult<T> for std::result::Result<T, E> {
     }
 }
 
-/// Figure size in pixels.
+/// Figure size in pixels (the SVG's width and height in user units).
 pub const SIZE: (u32, u32) = (1000, 750);
 
-/// A whole figure: the bitmap written to its path.
-pub type Figure<'b> = DrawingArea<BitMapBackend<'b>, Shift>;
+/// A whole figure on the backend `DB` (a bitmap for the PNG, an SVG document).
+pub type Figure<DB> = DrawingArea<DB, Shift>;
 
 /// A chart with `f64` coordinates on both axes, drawn on a [`Figure`].
-pub type XyChart<'a, 'b> =
-    ChartContext<'a, BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+pub type XyChart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
 
-/// A white figure of [`SIZE`] pixels, to be written to `path` when presented.
-pub fn blank_figure(path: &Path) -> Result<Figure<'_>> {
-    let root = BitMapBackend::new(path, SIZE).into_drawing_area();
+/// A figure's drawing, written through any plotters backend: the one code behind a figure's
+/// PNG and its SVG ([`write_figure`]).
+pub trait Draw {
+    /// The page size in pixels; [`SIZE`] unless the figure says otherwise.
+    fn size(&self) -> (u32, u32) {
+        SIZE
+    }
+
+    /// Draws the figure on `root`, a white page of [`Draw::size`]; `path` names the file in
+    /// errors.
+    fn draw<DB: DrawingBackend>(&self, root: &Figure<DB>, path: &Path) -> Result<()>;
+}
+
+/// The SVG written beside the PNG `png`: the same name with the extension `svg`.
+pub fn svg_path(png: &Path) -> PathBuf {
+    png.with_extension("svg")
+}
+
+/// Writes `figure` to the PNG `path` and the same drawing to the SVG beside it
+/// ([`svg_path`]). A drawing failure names the file it was drawing.
+pub fn write_figure(figure: &impl Draw, path: &Path) -> Result<()> {
+    register_font();
+    let size = figure.size();
+    let root = BitMapBackend::new(path, size).into_drawing_area();
+    paint(figure, &root, path)?;
+    let svg = svg_path(path);
+    if svg != path {
+        let root = SVGBackend::new(&svg, size).into_drawing_area();
+        paint(figure, &root, &svg)?;
+    }
+    Ok(())
+}
+
+/// Fills `root` white, draws `figure` on it and writes it out.
+fn paint<DB: DrawingBackend>(figure: &impl Draw, root: &Figure<DB>, path: &Path) -> Result<()> {
     root.fill(&WHITE).at(path)?;
-    Ok(root)
+    figure.draw(root, path)?;
+    root.present().at(path)
 }
 
 /// The axes of a line figure (load-displacement curves, a property against a size): a
@@ -139,7 +175,11 @@ pub struct LineAxes {
 impl LineAxes {
     /// Draws the caption, the axes and the mesh on `root` (drawn to `path`); returns the chart
     /// to draw the series on.
-    pub fn draw<'a, 'b>(&self, root: &'a Figure<'b>, path: &Path) -> Result<XyChart<'a, 'b>> {
+    pub fn draw<'a, DB: DrawingBackend>(
+        &self,
+        root: &'a Figure<DB>,
+        path: &Path,
+    ) -> Result<XyChart<'a, DB>> {
         let mut chart = ChartBuilder::on(root)
             .margin(20)
             .caption(&self.caption, (FONT, self.caption_size))
@@ -182,15 +222,16 @@ pub fn draw_legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
 /// What [`plot_run`] did: the figures written and the ones that failed (with why).
 #[derive(Debug, Default)]
 pub struct PlotReport {
-    /// PNG files written.
+    /// PNG files written (each with its SVG beside it, [`svg_path`]).
     pub written: Vec<PathBuf>,
     /// Figures that could not be drawn, with the reason.
     pub failed: Vec<(String, PlotError)>,
 }
 
-/// Draws every figure the run directory `run` has data for into `run/plots/`. A figure that
-/// fails does not stop the others (see [`PlotReport::failed`]); only a run directory without
-/// `curve.csv` or an unwritable `plots/` is an error.
+/// Draws every figure the run directory `run` has data for into `run/plots/` (PNG and SVG,
+/// [`write_figure`]). A figure that fails does not stop the others (see
+/// [`PlotReport::failed`]); only a run directory without `curve.csv` or an unwritable
+/// `plots/` is an error.
 pub fn plot_run(run: &Path) -> Result<PlotReport> {
     let curve_path = run.join("curve.csv");
     if !curve_path.is_file() {
@@ -400,6 +441,33 @@ pub fn equal_aspect(
     let scale = (w * (1.0 + 2.0 * pad) / pw).max(h * (1.0 + 2.0 * pad) / ph);
     let (hw, hh) = (0.5 * scale * pw, 0.5 * scale * ph);
     ((cx - hw, cx + hw), (cy - hh, cy + hh))
+}
+
+/// Checks of the SVG written beside a PNG, for the tests.
+#[cfg(test)]
+pub(crate) mod svg_check {
+    use std::path::Path;
+
+    /// The SVG beside the PNG `png`, checked to be a whole document: it starts with `<svg`,
+    /// ends with `</svg>`, and every `<text>` element is closed.
+    pub(crate) fn read_beside(png: &Path) -> String {
+        let svg = super::svg_path(png);
+        let text = std::fs::read_to_string(&svg).unwrap_or_else(|e| panic!("{svg:?}: {e}"));
+        assert!(text.starts_with("<svg"), "{svg:?} starts with {:?}", &text[..20.min(text.len())]);
+        assert!(text.trim_end().ends_with("</svg>"), "{svg:?} is not closed");
+        assert_eq!(text.matches("<svg").count(), 1, "{svg:?}");
+        assert_eq!(text.matches("<text").count(), text.matches("</text>").count(), "{svg:?}");
+        text
+    }
+
+    /// The number of points of each `<polyline>` of `svg` stroked in `colour` (`#RRGGBB`).
+    pub(crate) fn polylines(svg: &str, colour: &str) -> Vec<usize> {
+        svg.lines()
+            .filter(|l| l.starts_with("<polyline") && l.contains(&format!("stroke=\"{colour}\"")))
+            .filter_map(|l| l.split("points=\"").nth(1)?.split('"').next())
+            .map(|p| p.split_whitespace().count())
+            .collect()
+    }
 }
 
 #[cfg(test)]
