@@ -47,6 +47,15 @@ const EXAMPLES: &[(&str, u64)] = &[
     ("scene-a-post-peak", 25),
     // 1.7 s for step 1 (400 points x 105 discs), the next four cheaper.
     ("panel-5m", 5),
+    // Staged jobs (issue 28), K = 2 each. 6.4 s for steps 1-2 (112 points x 147 discs, surcharge
+    // then the first push).
+    ("footing", 2),
+    // 1.0 s for steps 1-2 (32 points x 147 discs, at rest then the first active step).
+    ("retaining-wall", 2),
+    // 8.1 s for steps 1-2 (108 points x 147 discs, the first two geostatic steps).
+    ("slope", 2),
+    // 0.7 s for steps 1-2 (32 points x 147 discs, the first two loading steps).
+    ("cyclic-biaxial", 2),
 ];
 
 /// The workspace root (this crate is `master/cli`).
@@ -166,4 +175,24 @@ fn scene_a_post_peak() {
 #[test]
 fn panel_5m() {
     check_prefix("panel-5m");
+}
+
+#[test]
+fn footing() {
+    check_prefix("footing");
+}
+
+#[test]
+fn retaining_wall() {
+    check_prefix("retaining-wall");
+}
+
+#[test]
+fn slope() {
+    check_prefix("slope");
+}
+
+#[test]
+fn cyclic_biaxial() {
+    check_prefix("cyclic-biaxial");
 }
