@@ -118,7 +118,8 @@ fn the_master_hints_the_packings_disc_count() {
         },
     };
     let ids: Vec<_> = (0..3).map(|e| GaussPointId::new(e, 0)).collect();
-    let (_material, workers) = material_for(&job, &choice, &ids, None).unwrap();
+    let mesh = job.build_mesh().unwrap();
+    let workers = material_for(&job, &choice, &mesh, &ids, None).unwrap().workers;
     assert_eq!(workers, 1);
     assert_eq!(*hints.lock().unwrap(), vec![built]);
     assert_eq!(built, 105);

@@ -19,6 +19,7 @@ fn a_jobs_in_process_workers_are_capped_at_the_cores() {
         config: PoolConfig { in_process_threads: 1, ..PoolConfig::default() },
     };
     let ids: Vec<_> = (0..3).map(|e| GaussPointId::new(e, 0)).collect();
-    let (_material, workers) = material_for(&job, &choice, &ids, None).unwrap();
+    let mesh = job.build_mesh().unwrap();
+    let workers = material_for(&job, &choice, &mesh, &ids, None).unwrap().workers;
     assert_eq!(workers, cores);
 }

@@ -254,7 +254,7 @@ impl Digests {
 }
 
 /// FNV-1a digest of the job's physics: `[mesh]`, `[loading]`, `[material]` and, in a job
-/// that has them, its `[[stage]]`s, as JSON (a job without stages keeps the digest it had
+/// that has them, its `[[stage]]`s, `[[region]]`s and `[specimens]`, as JSON (a job without stages keeps the digest it had
 /// before stages existed). Output and worker settings may change between a run and its
 /// resume.
 pub fn job_digest(job: &Job) -> u64 {
@@ -263,7 +263,12 @@ pub fn job_digest(job: &Job) -> u64 {
     } else {
         serde_json::to_string(&(&job.mesh, &job.loading, &job.material, &job.stage))
     };
-    fnv1a(&json.unwrap_or_default())
+    let mut json = json.unwrap_or_default();
+    // Regions and specimens, in a job that has them.
+    if !job.region.is_empty() || job.specimens != Default::default() {
+        json.push_str(&serde_json::to_string(&(&job.region, &job.specimens)).unwrap_or_default());
+    }
+    fnv1a(&json)
 }
 
 /// FNV-1a digest of the job's `[newton]` settings as JSON.

@@ -91,7 +91,9 @@ fn dem_run_writes_snapshots_fields_and_plots() {
     let job = dem_job();
     // The job's material (one in-process worker), kept by the test to compare with the files.
     let ids: Vec<GaussPointId> = (0..4).map(|p| GaussPointId::new(0, p)).collect();
-    let (material, _) = material_for(&job, &WorkerChoice::default(), &ids, None).unwrap();
+    let mesh = job.build_mesh().unwrap();
+    let material =
+        material_for(&job, &WorkerChoice::default(), &mesh, &ids, None).unwrap().material;
     let pool = Arc::new(Mutex::new(material));
     run(&job, &dir, Some(Box::new(Shared(pool.clone()))));
 

@@ -22,7 +22,7 @@ pub enum Error {
     /// A named node or edge set does not exist in the mesh.
     #[error("unknown {kind} set `{name}` (known: {known})")]
     UnknownSet {
-        /// `node` or `edge`.
+        /// `node`, `edge` or `element`.
         kind: &'static str,
         /// The requested name.
         name: String,

@@ -68,7 +68,7 @@ fn run(
     let mesh = Mesh::rectangle(kind, 1.0, 1.0, n, n, [0.0, 0.0]).unwrap();
     let loading = Loading {
         dirichlet: clamp_all_sides(Field::Cosserat),
-        body: Some(BodyLoad::new(move |x| body(mat, x))),
+        body: Some(BodyLoad::new(move |_, x| body(mat, x))),
         ..Default::default()
     };
     let model = Model { mesh, field: Field::Cosserat, rule, loading };

@@ -63,7 +63,7 @@ fn q8_square_formats_22_and_41_agree() {
     assert_eq!(m.elements.len(), 4);
     for e in &m.elements {
         assert_eq!(e.kind, QuadKind::Q8);
-        assert_eq!(e.physical.as_deref(), Some("panel"));
+        assert_eq!(e.physicals, ["panel"]);
         // Straight edges: each mid-edge node halves its edge.
         for k in 0..4 {
             let (a, b) = (m.nodes[e.nodes[k]], m.nodes[e.nodes[(k + 1) % 4]]);
@@ -138,9 +138,7 @@ fn unstructured_plate_with_hole() {
     let m = v22;
     check_invariants(&m);
     assert!(m.elements.len() > 10);
-    assert!(
-        m.elements.iter().all(|e| e.kind == QuadKind::Q8 && e.physical.as_deref() == Some("plate"))
-    );
+    assert!(m.elements.iter().all(|e| e.kind == QuadKind::Q8 && e.physicals == ["plate"]));
     // The centre of the circle arcs is a geometry point no element uses: it is dropped.
     assert!(m.nodes.iter().all(|p| !close(*p, [0.5, 0.5])));
     // Hole nodes lie on the circle of radius 0.25 about (0.5, 0.5).
@@ -243,9 +241,14 @@ fn elements_in_several_groups_are_read_once() {
     assert_eq!(v22, v41);
     check_invariants(&v22);
     let plain = read_msh(&data("square_q8_v22.msh")).unwrap();
-    // Same nodes and elements as the plain square; the first physical surface wins.
+    // Same nodes and elements as the plain square, each element in both physical surfaces,
+    // in file order.
     assert_eq!(v22.nodes, plain.nodes);
-    assert_eq!(v22.elements, plain.elements);
+    assert_eq!(v22.elements.len(), plain.elements.len());
+    for (two, one) in v22.elements.iter().zip(&plain.elements) {
+        assert_eq!((two.kind, &two.nodes), (one.kind, &one.nodes));
+        assert_eq!(two.physicals, ["panel", "other"]);
+    }
     // "all" holds the whole boundary: 16 nodes, 8 edges, each once.
     assert_eq!(v22.node_groups["all"].len(), 16);
     assert_eq!(v22.edge_groups["all"].len(), 8);

@@ -65,7 +65,7 @@ fn raw_description_and_structured_mesh_agree() {
             .collect();
         edge_groups.insert(name.clone(), list);
     }
-    let desc = MeshDescription { nodes, elements, node_groups: BTreeMap::new(), edge_groups };
+    let desc = MeshDescription { nodes, elements, edge_groups, ..Default::default() };
     let raw = Mesh::from_description(desc).unwrap();
 
     let (a, b) = (solve(structured), solve(raw));

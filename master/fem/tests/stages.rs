@@ -153,7 +153,7 @@ fn self_weight_settles_a_column_as_the_closed_form() {
             Dirichlet::new("left", Component::Ux, 0.0),
             Dirichlet::new("right", Component::Ux, 0.0),
         ],
-        body: Some(BodyLoad::new(move |_| [0.0, -gamma, 0.0])),
+        body: Some(BodyLoad::new(move |_, _| [0.0, -gamma, 0.0])),
         body_ramp: Ramp::Linear,
         ..Default::default()
     };

@@ -297,11 +297,17 @@ pub fn estimate(job: &Job, mesh: MeshCounts) -> Estimate {
         keys: point_keys.clone(),
     });
 
-    let discs = match &job.material {
-        MaterialSection::Dem { assembly } => assembly.disc_count_hint() as f64,
-        MaterialSection::Elastic { .. } => 0.0,
-    };
-    if let MaterialSection::Dem { assembly } = &job.material {
+    // With regions, a bound: every point takes the largest DEM assembly of the job.
+    let largest = job
+        .materials()
+        .into_iter()
+        .filter_map(|m| match m {
+            MaterialSection::Dem { assembly } => Some(assembly),
+            MaterialSection::Elastic { .. } => None,
+        })
+        .max_by_key(|a| a.disc_count_hint());
+    let discs = largest.map_or(0.0, |a| a.disc_count_hint() as f64);
+    if let Some(assembly) = largest {
         let mut keys = point_keys.clone();
         keys.extend(packing_keys(&assembly.packing));
         let all_discs = gauss_points * discs;

@@ -16,6 +16,7 @@ use cosdem_fem::solve::{
     Dirichlet, EdgeLoad, EdgeLoadKind, Loading, Platens, Ramp, SolverSettings,
 };
 use std::path::Path;
+use std::sync::Arc;
 
 impl From<ComponentChoice> for Component {
     fn from(c: ComponentChoice) -> Self {
@@ -27,11 +28,11 @@ impl From<ComponentChoice> for Component {
     }
 }
 
-impl Job {
-    /// The linear-elastic Cosserat material of an `elastic` job (its defaults filled in:
-    /// Gc = G / 2, lc = 0.01 m); `None` for a DEM job.
+impl MaterialSection {
+    /// The linear-elastic Cosserat material of an `elastic` section (its defaults filled in:
+    /// Gc = G / 2, lc = 0.01 m); `None` for a DEM one.
     pub fn elastic(&self) -> Option<ElasticCosserat> {
-        match &self.material {
+        match self {
             MaterialSection::Elastic { shear_modulus, poisson, cosserat_modulus, length } => {
                 let g = *shear_modulus;
                 Some(ElasticCosserat::new(
@@ -43,6 +44,15 @@ impl Job {
             }
             MaterialSection::Dem { .. } => None,
         }
+    }
+}
+
+impl Job {
+    /// The linear-elastic Cosserat material of an `elastic` job's `[material]` (its defaults
+    /// filled in: Gc = G / 2, lc = 0.01 m); `None` for a DEM job. A region's is
+    /// [`MaterialSection::elastic`] of its section.
+    pub fn elastic(&self) -> Option<ElasticCosserat> {
+        self.material.elastic()
     }
 
     /// The continuum field.
@@ -140,13 +150,14 @@ impl Job {
         }
     }
 
-    /// The FE model: mesh, field, rule, loading.
+    /// The FE model: mesh, field, rule, loading. Checks the sets the job names and the
+    /// regions ([`Job::element_materials`]) against the mesh.
     pub fn model(&self) -> Result<cosdem_fem::solve::Model> {
         let mesh = self.build_mesh()?;
-        // The curve's load is the reaction of this set: a name the mesh lacks would report a
-        // load of -0 at every step.
+        // Without `[output.curve]` the curve's load is the reaction of this set: a name the
+        // mesh lacks would report a load of -0 at every step. With it, the set is not used.
         let load_set = &self.loading.load_set;
-        if !mesh.node_sets.contains_key(load_set) {
+        if self.output.curve.is_none() && !mesh.node_sets.contains_key(load_set) {
             return Err(Error::InvalidSetting {
                 field: "loading.load_set",
                 value: load_set.clone(),
@@ -160,15 +171,16 @@ impl Job {
             curve.check_sets(&mesh)?;
         }
         self.check_stage_sets(&mesh)?;
-        Ok(cosdem_fem::solve::Model {
-            mesh,
-            field: self.field(),
-            rule: self.rule(),
-            loading: match self.is_staged() {
-                true => self.stages()?.swap_remove(0).loading,
-                false => self.loading(),
-            },
-        })
+        // A bad region is refused here, before anything runs.
+        let element_materials = self.element_materials(&mesh)?;
+        let loading = match self.is_staged() {
+            true => {
+                let map = (!self.region.is_empty()).then(|| Arc::new(element_materials));
+                self.stages_with(map)?.swap_remove(0).loading
+            }
+            false => self.loading(),
+        };
+        Ok(cosdem_fem::solve::Model { mesh, field: self.field(), rule: self.rule(), loading })
     }
 
     /// Newton and step settings.
@@ -233,6 +245,23 @@ mod tests {
         assert!(e.to_string().contains("known: ") && e.to_string().contains("top"), "{e}");
         job.loading.load_set = "bottom".into();
         job.model().unwrap();
+    }
+
+    /// With `[output.curve]` the curve names its own sets and `loading.load_set` (default
+    /// `top`) is not used: a mesh without that set is not refused for it (a Gmsh footing mesh
+    /// without `top` was), while a curve set the mesh lacks still is.
+    #[test]
+    fn load_set_is_not_checked_when_the_curve_names_its_sets() {
+        let text = format!(
+            "{}\n[output.curve]\ncontrol = {{ set = \"bottom\", component = \"uy\" }}\nload = {{ set = \"bottom\", component = \"uy\" }}\n",
+            fixtures::text("elastic-panel")
+        );
+        let mut job = Job::from_toml(&text, "j.toml").unwrap();
+        job.loading.load_set = "nosuch".into();
+        job.model().unwrap();
+        job.output.curve.as_mut().unwrap().load.set = "nosuch".into();
+        let e = job.model().unwrap_err().to_string();
+        assert!(e.contains("nosuch"), "{e}");
     }
 
     #[test]

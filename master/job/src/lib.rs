@@ -10,8 +10,13 @@
 //! - `schema`: the tables as serde structs ([`Job`], [`MeshSection`], [`MaterialSection`], ...);
 //! - `arrays`: the fixed-length arrays (`mesh.origin`, `output.snapshots`), length checked;
 //! - `material`: reading `[material]` as a plain struct, so errors keep their TOML position;
+//! - `region`: `[[region]]`, parts of the mesh with their own material and bulk density
+//!   ([`Job::element_materials`], [`Job::materials`]);
+//! - `specimens`: `[specimens]`, the distinct DEM specimens and their consolidation levels
+//!   ([`SpecimensSection::specimen_of`], [`SpecimensSection::level_of`]);
 //! - `load`: reading TOML text or a regular file of at most [`MAX_JOB_FILE_BYTES`]
 //!   ([`Job::from_toml`], [`Job::load`]);
+//! - `bulk`: the bulk density of a DEM material from its assembly, for gravity;
 //! - `packing_file`: a `kind = "file"` packing read on the master into its explicit discs;
 //! - `validate`: ranges and combinations ([`Job::validate`]);
 //! - `curve`: `[output.curve]`, the curve's axes, and the `.pvd` time rule ([`Job::pvd_time`]);
@@ -23,6 +28,7 @@
 
 pub mod admission;
 mod arrays;
+pub mod bulk;
 mod convert;
 mod curve;
 #[cfg(any(test, feature = "fixtures"))]
@@ -30,19 +36,23 @@ pub mod fixtures;
 mod load;
 mod material;
 mod packing_file;
+mod region;
 mod schema;
+mod specimens;
 mod stage;
 mod validate;
 
 pub use curve::{CurveQuantity, CurveSection, PvdTime};
 pub use load::MAX_JOB_FILE_BYTES;
 pub use packing_file::MAX_PACKING_FILE_BYTES;
+pub use region::RegionSection;
 pub use schema::{
     ComponentChoice, Compression, Continuum, ElementChoice, Integration, Job, LoadingSection,
     MaterialSection, MeshKind, MeshSection, Moving, NewtonSection, OutputSection,
     PAPER_LINEAR_RANGE, PlatenChoice, Prescribed, PressureLoad, RampChoice, VtkFormat,
     WorkersSection,
 };
+pub use specimens::{Consolidation, SpecimenCount, SpecimensSection};
 pub use stage::{
     MAX_STAGES, SolverStage, StageGravity, StagePrescribed, StagePressure, StageRamp, StageSection,
     StageTraction,

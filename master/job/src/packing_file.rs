@@ -15,10 +15,25 @@ use std::path::Path;
 /// takes at most about 120 bytes in either format.
 pub const MAX_PACKING_FILE_BYTES: u64 = 256 << 20;
 
-/// Reads the packing file of `job`'s assembly, if it names one, into its explicit disc list;
-/// `base` is the directory relative paths start from, `origin` names the job in errors.
+/// Reads the packing file of each of `job`'s assemblies (`[material]`'s and every
+/// region's), if it names one, into its explicit disc list; `base` is the directory relative
+/// paths start from, `origin` names the job in errors.
 pub(crate) fn resolve(job: &mut Job, base: &Path, origin: &str) -> Result<()> {
-    let MaterialSection::Dem { assembly } = &mut job.material else {
+    resolve_one(&mut job.material, "material", base, origin)?;
+    for (i, region) in job.region.iter_mut().enumerate() {
+        resolve_one(&mut region.material, &format!("region[{i}].material"), base, origin)?;
+    }
+    Ok(())
+}
+
+/// [`resolve`] for one material, whose key is `prefix` (`material`, `region[0].material`).
+fn resolve_one(
+    material: &mut MaterialSection,
+    prefix: &str,
+    base: &Path,
+    origin: &str,
+) -> Result<()> {
+    let MaterialSection::Dem { assembly } = material else {
         return Ok(());
     };
     let PackingSpec::File { file, format } = &assembly.packing else {
@@ -29,7 +44,7 @@ pub(crate) fn resolve(job: &mut Job, base: &Path, origin: &str) -> Result<()> {
     let err = |message: String| Error::JobFile {
         file: origin.to_string(),
         message: format!(
-            "material.assembly.packing.file = {:?}: {message}",
+            "{prefix}.assembly.packing.file = {:?}: {message}",
             file.display().to_string()
         ),
     };
@@ -77,6 +92,33 @@ mod tests {
             panic!("{:?}", assembly.packing.kind())
         };
         assert!(radii.len() >= 100, "{}", radii.len());
+    }
+
+    /// A region's packing file is read as `[material]`'s (relative to the job file), and its
+    /// errors name the region's key.
+    #[test]
+    fn a_region_packing_file_becomes_discs_and_its_errors_name_the_region() {
+        let dir = scratch("region");
+        let text = fixtures::text("packing-file").replace(
+            "[material]\nkind = \"dem\"",
+            "[material]\nkind = \"elastic\"\nshear_modulus = 1e7\npoisson = 0.3\n\n[[region]]\nelements = [[0, 0]]\n[region.material]\nkind = \"dem\"",
+        );
+        let text =
+            text.replace("[material.assembly.packing]", "[region.material.assembly.packing]");
+        let text = text.replace("../../examples/packings/random-270.txt", "discs.txt");
+        // A 5 x 5 square lattice of unit discs: a region of 10 x 10, five diameters each way.
+        let lattice: String =
+            (0..25).map(|k| format!("{} {} 0 1\n", 2 * (k % 5), 2 * (k / 5))).collect();
+        std::fs::write(dir.join("discs.txt"), lattice).unwrap();
+        std::fs::write(dir.join("job.toml"), &text).unwrap();
+        let job = Job::load(&dir.join("job.toml")).unwrap_or_else(|e| panic!("{e}\n{text}"));
+        let crate::MaterialSection::Dem { assembly } = &job.region[0].material else { panic!() };
+        let PackingSpec::Explicit { radii, .. } = &assembly.packing else { panic!() };
+        assert_eq!(radii, &[1.0; 25]);
+        std::fs::write(dir.join("job.toml"), text.replace("discs.txt", "missing.txt")).unwrap();
+        let e = Job::load(&dir.join("job.toml")).unwrap_err().to_string();
+        assert!(e.contains("region[0].material.assembly.packing.file = \"missing.txt\""), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     /// A missing file, a bad line and an unknown format are errors naming the job, the key,

@@ -27,8 +27,15 @@ pub struct Job {
     /// The loading in stages (`[[stage]]`), instead of `[loading]`'s loads.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub stage: Vec<crate::stage::StageSection>,
-    /// The material at the Gauss points.
+    /// The material at the Gauss points (of the elements in no `[[region]]`).
     pub material: MaterialSection,
+    /// Parts of the mesh with their own material (`[[region]]`); none: `[material]` everywhere.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub region: Vec<crate::region::RegionSection>,
+    /// The DEM specimens and their consolidation (`[specimens]`); default: one specimen, the
+    /// packing's own confining stress.
+    #[serde(default, skip_serializing_if = "crate::specimens::SpecimensSection::is_default")]
+    pub specimens: crate::specimens::SpecimensSection,
     /// Newton-Raphson and step control.
     #[serde(default)]
     pub newton: NewtonSection,

@@ -11,14 +11,16 @@
 //! A job without `[[stage]]` is the one stage of its `[loading]`, exactly as before stages.
 //! Keys in errors name a stage by its index in the file, from 0: `stage[1].prescribed[0].set`.
 
+use crate::region::body_load;
 use crate::schema::{ComponentChoice, Job};
 use crate::validate::interned;
 use cosdem_fem::assembly::Component;
 use cosdem_fem::error::{Error, Result};
 use cosdem_fem::mesh::Mesh;
-use cosdem_fem::solve::{BodyLoad, Dirichlet, EdgeLoad, EdgeLoadKind, Loading, Ramp};
+use cosdem_fem::solve::{Dirichlet, EdgeLoad, EdgeLoadKind, Loading, Ramp};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
+use std::sync::Arc;
 
 /// Most stages a job expands to (repetitions and path points counted): a cyclic test of a
 /// few hundred cycles fits; a typo of `repeat = 1e9` does not.
@@ -96,8 +98,12 @@ pub struct StageGravity {
     /// Acceleration `[g_x, g_y]` (m/s^2), e.g. `[0, -9.81]`.
     pub acceleration: [f64; 2],
     /// Bulk density of the material (kg/m^3 of the continuum: the solid density times the
-    /// solid fraction for a dry granular material).
-    pub density: f64,
+    /// solid fraction for a dry granular material); an element of a `[[region]]` with
+    /// `bulk_density` takes the region's instead. Left out, a DEM material weighs its
+    /// assembly's solid density times solid fraction ([`crate::bulk`]); an elastic one needs
+    /// its region's `bulk_density`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub density: Option<f64>,
     /// `constant` (default), `linear` or `remove`.
     #[serde(default = "default_ramp")]
     pub ramp: StageRamp,
@@ -177,8 +183,8 @@ struct InForce {
     held: Vec<(String, Component)>,
     /// Edge loads by (set, is traction).
     edges: BTreeMap<(String, bool), Edge>,
-    /// Body force density `[f_x, f_y]`.
-    gravity: Option<[f64; 2]>,
+    /// Body force density `[f_x, f_y]` per material (as numbered by [`Job::materials`]).
+    gravity: Option<Vec<[f64; 2]>>,
 }
 
 fn component(c: ComponentChoice) -> Component {
@@ -193,11 +199,6 @@ fn bad(field: &'static str, value: impl Into<String>, reason: impl Into<String>)
     Error::InvalidSetting { field, value: value.into(), reason: reason.into() }
 }
 
-/// The body force of a density: `[rho g_x, rho g_y]`.
-fn body(g: &StageGravity) -> [f64; 2] {
-    [g.density * g.acceleration[0], g.density * g.acceleration[1]]
-}
-
 impl Job {
     /// Whether the job is written in stages (`[[stage]]`).
     pub fn is_staged(&self) -> bool {
@@ -207,7 +208,23 @@ impl Job {
     /// The stages the solver runs, in order, repetitions and path points expanded; the
     /// first one's loading is the model's ([`Job::model`]). A job without `[[stage]]` is the
     /// one stage of its `[loading]`.
+    ///
+    /// With regions and gravity, the body force depends on the element's region: the mesh is
+    /// built to find them ([`Job::element_materials`]).
     pub fn stages(&self) -> Result<Vec<SolverStage>> {
+        let gravity = self.stage.iter().any(|s| s.gravity.is_some());
+        let map = match !self.region.is_empty() && gravity {
+            true => Some(Arc::new(self.element_materials(&self.build_mesh()?)?)),
+            false => None,
+        };
+        self.stages_with(map)
+    }
+
+    /// [`Job::stages`] given the material of every element (`None` without regions).
+    pub(crate) fn stages_with(
+        &self,
+        element_materials: Option<Arc<Vec<usize>>>,
+    ) -> Result<Vec<SolverStage>> {
         if !self.is_staged() {
             let steps = self.solver_settings()?.steps;
             return Ok(vec![SolverStage { loading: self.loading(), steps, name: String::new() }]);
@@ -218,7 +235,8 @@ impl Job {
             let points = stage.prescribed.iter().map(|p| p.path.len()).max().unwrap_or(0);
             for r in 0..stage.repeat {
                 for k in 0..points.max(1) {
-                    let loading = self.stage_loading(i, stage, k, &mut force)?;
+                    let loading =
+                        self.stage_loading(i, stage, k, &mut force, element_materials.as_ref())?;
                     let mut name = stage.name.clone();
                     if stage.repeat > 1 {
                         name = format!("{name} {}/{}", r + 1, stage.repeat);
@@ -247,6 +265,7 @@ impl Job {
         stage: &StageSection,
         k: usize,
         force: &mut InForce,
+        element_materials: Option<&Arc<Vec<usize>>>,
     ) -> Result<Loading> {
         let mut loading = Loading::default();
         // Held dofs first: the stage's own entries come later and win.
@@ -340,15 +359,24 @@ impl Job {
                 None => force.edges.remove(&id),
             };
         }
-        // Gravity: held, changed or removed like an edge load.
-        let (fixed, ramped, ramp, after) = match (&stage.gravity, force.gravity) {
-            (None, old) => (old, None, Ramp::Constant, old),
+        // Gravity: held, changed or removed like an edge load; one force per material.
+        let map = element_materials.map(|m| m.as_slice());
+        let (fixed, ramped, ramp, after) = match (&stage.gravity, force.gravity.take()) {
+            (None, old) => (old.clone(), None, Ramp::Constant, old),
             (Some(g), old) => match g.ramp {
-                StageRamp::Constant => (Some(body(g)), None, Ramp::Constant, Some(body(g))),
+                StageRamp::Constant => {
+                    let new = self.body_forces(i, g, map)?;
+                    (Some(new.clone()), None, Ramp::Constant, Some(new))
+                }
                 StageRamp::Linear => {
-                    let new = body(g);
-                    let o = old.unwrap_or([0.0; 2]);
-                    (old, Some([new[0] - o[0], new[1] - o[1]]), Ramp::Linear, Some(new))
+                    let new = self.body_forces(i, g, map)?;
+                    let zero = vec![[0.0; 2]; new.len()];
+                    let change = new
+                        .iter()
+                        .zip(old.as_ref().unwrap_or(&zero))
+                        .map(|(n, o)| [n[0] - o[0], n[1] - o[1]])
+                        .collect();
+                    (old, Some(change), Ramp::Linear, Some(new))
                 }
                 StageRamp::Remove => {
                     let Some(o) = old else {
@@ -365,24 +393,25 @@ impl Job {
         force.gravity = after;
         // A stage has one body force with one ramp: held (constant), applied (linear) or
         // removed (down).
+        let map = element_materials.cloned();
         match (fixed, ramped) {
             (None, None) => {}
             (Some(f), None) => {
-                loading.body = Some(BodyLoad::new(move |_| [f[0], f[1], 0.0]));
+                loading.body = Some(body_load(f, map));
                 loading.body_ramp = Ramp::Constant;
             }
             (None, Some(r)) => {
-                loading.body = Some(BodyLoad::new(move |_| [r[0], r[1], 0.0]));
+                loading.body = Some(body_load(r, map));
                 loading.body_ramp = ramp;
             }
             (Some(f), Some(_)) => {
                 // Held f plus r growing would need two body forces with two ramps.
+                let held = if f.len() == 1 { format!("{:?}", f[0]) } else { format!("{f:?}") };
                 return Err(bad(
                     key(i, ".gravity.ramp"),
                     "linear",
                     format!(
-                        "changes a gravity already in force ({:?}) linearly to another: remove it in one stage and apply the new one in the next, or apply it at once (ramp = \"constant\")",
-                        [f[0], f[1]]
+                        "changes a gravity already in force ({held}) linearly to another: remove it in one stage and apply the new one in the next, or apply it at once (ramp = \"constant\")"
                     ),
                 ));
             }
@@ -531,12 +560,22 @@ impl Job {
                         "must be finite",
                     ));
                 }
-                if !(g.density.is_finite() && g.density > 0.0) {
-                    return Err(bad(
-                        key(i, ".gravity.density"),
-                        format!("{:?}", g.density),
-                        "a body force needs the material's bulk density (kg/m^3, finite and > 0)",
-                    ));
+                match g.density {
+                    Some(rho) if !(rho.is_finite() && rho > 0.0) => {
+                        return Err(bad(
+                            key(i, ".gravity.density"),
+                            format!("{rho:?}"),
+                            "a body force needs the material's bulk density (kg/m^3, finite and > 0)",
+                        ));
+                    }
+                    None if g.ramp != StageRamp::Remove && !self.regions_weigh_themselves() => {
+                        return Err(bad(
+                            key(i, ".gravity.density"),
+                            "missing",
+                            "a body force needs the material's bulk density (kg/m^3, finite and > 0); it may be left out only when every material is DEM (weighed from its assembly) or its [[region]] gives a bulk_density, or with ramp = \"remove\"",
+                        ));
+                    }
+                    _ => {}
                 }
             }
         }

@@ -28,11 +28,12 @@ fn positive(field: &'static str, v: f64) -> Result<f64> {
     if v.is_finite() && v > 0.0 { Ok(v) } else { Err(bad(field, num(v), "must be finite and > 0")) }
 }
 
-/// The job-file key of a field of `[material.assembly]` (`packing.side` ->
+/// The job-file key of a field of a material's assembly: `prefix` (`material.` or
+/// `region[2].material.`) then `assembly.` and the field (`packing.side` ->
 /// `material.assembly.packing.side`). The DEM spec names its fields relative to the assembly
 /// with `&'static str`; the dotted keys are interned once each (the spec has a few dozen).
-fn assembly_key(field: &str) -> &'static str {
-    interned(format!("material.assembly.{field}"))
+fn assembly_key(prefix: &str, field: &str) -> &'static str {
+    interned(format!("{prefix}assembly.{field}"))
 }
 
 /// A dotted job-file key made at run time (`stage[2].pressure[0].value`, a field of
@@ -65,15 +66,18 @@ fn readable(value: &str) -> String {
     out
 }
 
-/// The DEM spec's error as the job file's: the key with its `material.assembly.` prefix.
-fn assembly_error(e: cosdem_dem::Error) -> Error {
+/// The DEM spec's error as the job file's: the key with the material's prefix
+/// (`material.assembly.`, `region[0].material.assembly.`).
+fn assembly_error(prefix: &str, e: cosdem_dem::Error) -> Error {
     match e {
         cosdem_dem::Error::InvalidSpec { field, value, reason } => Error::InvalidSetting {
-            field: assembly_key(field),
+            field: assembly_key(prefix, field),
             value: readable(&value),
             reason: reason.into(),
         },
-        other => bad("material.assembly", other.to_string(), "invalid assembly spec"),
+        other => {
+            bad(interned(format!("{prefix}assembly")), other.to_string(), "invalid assembly spec")
+        }
     }
 }
 
@@ -83,7 +87,13 @@ impl Job {
         self.validate_mesh()?;
         self.validate_loading()?;
         self.validate_stages()?;
-        self.validate_material()?;
+        self.validate_regions()?;
+        check_material(&self.material, "material.")?;
+        for (i, r) in self.region.iter().enumerate() {
+            let prefix = format!("region[{i}].material.");
+            check_material(&r.material, &prefix)?;
+        }
+        self.validate_specimens()?;
         let n = &self.newton;
         if n.max_iterations == 0 {
             return Err(bad("newton.max_iterations", "0", "must be >= 1"));
@@ -251,52 +261,51 @@ impl Job {
         }
         Ok(())
     }
+}
 
-    fn validate_material(&self) -> Result<()> {
-        match &self.material {
-            MaterialSection::Elastic { shear_modulus, poisson, cosserat_modulus, length } => {
-                positive("material.shear_modulus", *shear_modulus)?;
-                if !(*poisson > -1.0 && *poisson < 0.5) {
-                    return Err(bad("material.poisson", num(*poisson), "must be in (-1, 0.5)"));
-                }
-                if let Some(gc) = cosserat_modulus
-                    && !(gc.is_finite() && *gc >= 0.0)
-                {
-                    return Err(bad(
-                        "material.cosserat_modulus",
-                        num(*gc),
-                        "must be finite and >= 0",
-                    ));
-                }
-                if let Some(lc) = length
-                    && !(lc.is_finite() && *lc >= 0.0)
-                {
-                    return Err(bad("material.length", num(*lc), "must be finite and >= 0"));
-                }
-                // Each value may be finite and the moduli they make still overflow.
-                let m = self.elastic().expect("elastic material");
-                let d = m.tangent();
-                if !d[..4].iter().flatten().all(|v| v.is_finite()) {
-                    return Err(bad(
-                        "material.shear_modulus",
-                        num(*shear_modulus),
-                        "with this Poisson's ratio and Cosserat modulus the elastic moduli overflow",
-                    ));
-                }
-                if !d[4][4].is_finite() {
-                    return Err(bad(
-                        "material.length",
-                        num(m.length),
-                        "the bending modulus 2 G lc^2 overflows",
-                    ));
-                }
+/// The checks of one material, `[material]` or a region's, whose keys start with `prefix`
+/// (`material.`, `region[2].material.`).
+fn check_material(material: &MaterialSection, prefix: &str) -> Result<()> {
+    let at = |name: &str| interned(format!("{prefix}{name}"));
+    match material {
+        MaterialSection::Elastic { shear_modulus, poisson, cosserat_modulus, length } => {
+            positive(at("shear_modulus"), *shear_modulus)?;
+            if !(*poisson > -1.0 && *poisson < 0.5) {
+                return Err(bad(at("poisson"), num(*poisson), "must be in (-1, 0.5)"));
             }
-            MaterialSection::Dem { assembly } => {
-                assembly.validate().map_err(assembly_error)?;
+            if let Some(gc) = cosserat_modulus
+                && !(gc.is_finite() && *gc >= 0.0)
+            {
+                return Err(bad(at("cosserat_modulus"), num(*gc), "must be finite and >= 0"));
+            }
+            if let Some(lc) = length
+                && !(lc.is_finite() && *lc >= 0.0)
+            {
+                return Err(bad(at("length"), num(*lc), "must be finite and >= 0"));
+            }
+            // Each value may be finite and the moduli they make still overflow.
+            let m = material.elastic().expect("elastic material");
+            let d = m.tangent();
+            if !d[..4].iter().flatten().all(|v| v.is_finite()) {
+                return Err(bad(
+                    at("shear_modulus"),
+                    num(*shear_modulus),
+                    "with this Poisson's ratio and Cosserat modulus the elastic moduli overflow",
+                ));
+            }
+            if !d[4][4].is_finite() {
+                return Err(bad(
+                    at("length"),
+                    num(m.length),
+                    "the bending modulus 2 G lc^2 overflows",
+                ));
             }
         }
-        Ok(())
+        MaterialSection::Dem { assembly } => {
+            assembly.validate().map_err(|e| assembly_error(prefix, e))?;
+        }
     }
+    Ok(())
 }
 
 /// The rectangle's node coordinates are computed as `origin + l * i / (2 n)` (`i` up to

@@ -135,7 +135,7 @@ prescribed = [{ set = "top", component = "uy", increment = -1e-3 }]
     );
     for (k, ramp) in [(0, Ramp::Linear), (1, Ramp::Constant)] {
         let body = s[k].loading.body.as_ref().expect("gravity in force");
-        assert_eq!((body.0)([0.3, 0.7]), [0.0, -19620.0, 0.0]);
+        assert_eq!((body.0)(0, [0.3, 0.7]), [0.0, -19620.0, 0.0]);
         assert_eq!(s[k].loading.body_ramp, ramp);
     }
 }

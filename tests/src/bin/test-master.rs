@@ -177,7 +177,9 @@ fn main() {
             if let Some(f) = fault.filter(|f| f.phase == Phase::Setup) {
                 f.strike();
             }
-            let (inner, _) = material_for(job_ref, &WorkerChoice::default(), ids, saved)?;
+            let mesh = job_ref.build_mesh()?;
+            let inner =
+                material_for(job_ref, &WorkerChoice::default(), &mesh, ids, saved)?.material;
             Ok(Box::new(Faulty { inner, fault, step: 1, evaluations: 0 }))
         })
         .overwrite(overwrite)

@@ -35,7 +35,7 @@ pub fn config(defer_commits: bool) -> PoolConfig {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Outputs {
     pub curve: Vec<u8>,
-    /// `summary.json` without `wall_seconds` and `workers`.
+    /// `summary.json` without `wall_seconds`, `workers` and the specimens' generation time.
     pub summary: serde_json::Value,
     pub checkpoint: Vec<u8>,
 }
@@ -49,6 +49,9 @@ impl Outputs {
         if let Some(m) = summary.as_object_mut() {
             m.remove("wall_seconds");
             m.remove("workers");
+            if let Some(s) = m.get_mut("specimens").and_then(|s| s.as_object_mut()) {
+                s.remove("seconds");
+            }
         }
         Outputs { curve: read("curve.csv"), summary, checkpoint: read("checkpoint.bin") }
     }

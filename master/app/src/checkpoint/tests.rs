@@ -57,7 +57,8 @@ fn dem_material(
 ) -> Box<dyn Material> {
     let config = PoolConfig { in_process_threads: 1, ..PoolConfig::default() };
     let workers = WorkerChoice { addresses: Vec::new(), config };
-    material_for(job, &workers, ids, states).unwrap().0
+    let mesh = job.build_mesh().unwrap();
+    material_for(job, &workers, &mesh, ids, states).unwrap().material
 }
 
 /// Sets the stop flag once step `at` is observed (what Ctrl-C during that step does).

@@ -42,6 +42,8 @@ pub struct PackingOutput {
     pub formats: Vec<OutputFormat>,
     /// The assemblies' density (the DEM spec's; the spec's default for a job without discs).
     pub density: f64,
+    /// Per element, the density of its region's assemblies (empty: `density` everywhere).
+    pub element_density: Vec<f64>,
 }
 
 impl PackingOutput {
@@ -51,7 +53,25 @@ impl PackingOutput {
             MaterialSection::Dem { assembly } => assembly.density,
             MaterialSection::Elastic { .. } => cosdem_dem::AssemblySpec::default().density,
         };
-        Self { formats: job.output.packing_formats.clone(), density }
+        Self { formats: job.output.packing_formats.clone(), density, element_density: Vec::new() }
+    }
+
+    /// The density of element `e`'s assemblies.
+    pub fn density_of(&self, e: u32) -> f64 {
+        self.element_density.get(e as usize).copied().unwrap_or(self.density)
+    }
+
+    /// Each element's density from its material (`element_materials`:
+    /// [`Job::element_materials`]); an elastic element keeps `density`.
+    pub fn set_regions(&mut self, job: &Job, element_materials: &[usize]) {
+        let materials = job.materials();
+        self.element_density = element_materials
+            .iter()
+            .map(|&m| match materials[m] {
+                MaterialSection::Dem { assembly } => assembly.density,
+                MaterialSection::Elastic { .. } => self.density,
+            })
+            .collect();
     }
 }
 

@@ -149,6 +149,10 @@ pub struct Summary {
     /// compression job without `[output.curve]` (displacement, as before).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pvd_time: Option<PvdTime>,
+    /// With DEM points: the distinct specimens generated, the points they back and the
+    /// generation's wall time (a resume keeps the first session's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub specimens: Option<crate::run::SpecimenReport>,
 }
 
 impl Summary {
@@ -328,6 +332,7 @@ impl RunWriter {
             tolerated_steps: count("tolerated_steps"),
             forced_steps: count("forced_steps"),
             wall_seconds: before,
+            specimens: serde_json::from_value(old["specimens"].clone()).ok(),
             ..Summary::default()
         };
         fill_curve_fields(&mut summary, &settings, &curve);
@@ -423,6 +428,16 @@ impl RunWriter {
     /// Records the number of workers in the summary.
     pub fn set_workers(&mut self, n: usize) {
         self.summary.workers = n;
+    }
+
+    /// Gives each element's packing files its region's density (before [`Self::watch`]).
+    pub fn set_regions(&mut self, job: &cosdem_job::Job, element_materials: &[usize]) {
+        self.settings.packings.set_regions(job, element_materials);
+    }
+
+    /// Records what the specimens cost in the summary.
+    pub fn set_specimens(&mut self, report: crate::run::SpecimenReport) {
+        self.summary.specimens = Some(report);
     }
 
     /// Adds DEM steps that no step row carries to the summary's count: the failed attempts

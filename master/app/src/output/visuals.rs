@@ -165,7 +165,7 @@ impl VisualOutputs {
             let packing = snapshot_packing(&particles);
             for &format in &self.packings.formats {
                 let file = snapshot_packing_path(&sub, s.step, format);
-                write_packing(&file, &packing, self.packings.density, format)?;
+                write_packing(&file, &packing, self.packings.density_of(id.element), format)?;
             }
         }
         pvd.add(s.time, &path)

@@ -300,14 +300,17 @@ impl<'a> Run<'a> {
             Vec::new()
         };
         let saved = checkpoint.as_ref().map(Checkpoint::assembly_states);
-        let (mut material, n_workers) = match material {
-            None => material_for(job, &workers, &ids, saved)?,
+        let (mut material, n_workers, specimens) = match material {
+            None => {
+                let built = material_for(job, &workers, &solver.model().mesh, &ids, saved)?;
+                (built.material, built.workers, built.specimens)
+            }
             Some(build) => {
                 let mut m = build(&ids)?;
                 if let Some(states) = saved {
                     m.restore_states(states).map_err(cosdem_fem::Error::from)?;
                 }
-                (m, 0)
+                (m, 0, None)
             }
         };
         // The setup has succeeded: the run directory is the run's from here on.
@@ -346,6 +349,9 @@ impl<'a> Run<'a> {
                 "stopped by Ctrl-C or SIGTERM",
             ),
         };
+        if let Some(w) = writer.as_mut().filter(|_| !job.region.is_empty()) {
+            w.set_regions(job, &job.element_materials(&solver.model().mesh)?);
+        }
         let mut tap;
         let material: &mut dyn Material = match writer.as_mut() {
             Some(w) if snapshots => {
@@ -356,6 +362,9 @@ impl<'a> Run<'a> {
         };
         if let Some(w) = writer.as_mut() {
             w.set_workers(n_workers);
+            if let Some(report) = specimens {
+                w.set_specimens(report);
+            }
         }
         observer.on_start().map_err(RunError::Observer)?;
         let (outcome, reached_max) = {

@@ -9,20 +9,22 @@
 
 /// The [`Run`] builder: options, order of a run, outcome.
 pub mod driver;
+/// The in-situ mean stress of every Gauss point, for consolidating the DEM assemblies.
+pub mod in_situ;
+/// The job's materials per region and the DEM specimens per point ([`material_for`]).
+pub mod material;
 /// What a caller sees of a run ([`RunObserver`]) and the per-step hook.
 pub mod observer;
 
 pub use driver::{BuildMaterial, Ending, Run, RunOutcome};
+pub use material::{Built, SpecimenReport, material_for};
 pub use observer::{HookError, RunObserver};
 
 use crate::output::run_dir::{RunSettings, Summary};
 use cosdem_common::GaussPointId;
-use cosdem_common::micro::{AssemblyRequest, AssemblyState, BoundaryKind};
-use cosdem_fem::material::Material;
 use cosdem_fem::solve::Solver;
 use cosdem_job::{Job, MaterialSection};
-use cosdem_pool::{Pool, PoolConfig};
-use cosdem_worker::Dem;
+use cosdem_pool::PoolConfig;
 use std::path::Path;
 
 /// Errors of a whole run.
@@ -62,6 +64,9 @@ pub enum RunError {
         /// The message limit.
         limit: usize,
     },
+    /// The materials of the regions could not be put together.
+    #[error("materials of the regions: {0}")]
+    Regions(#[from] cosdem_fem::material::RegionsError),
     /// The Ctrl-C / SIGTERM handler could not be installed.
     #[error("installing the Ctrl-C handler")]
     Signals(#[source] std::io::Error),
@@ -95,11 +100,13 @@ pub fn admit(
     in_process: bool,
     max_message_bytes: usize,
 ) -> Result<Vec<String>, RunError> {
-    if let MaterialSection::Dem { assembly } = &job.material {
-        let discs = assembly.disc_count_hint();
-        let bytes = cosdem_dem::spec::state_bytes(discs);
-        if bytes > max_message_bytes as u64 {
-            return Err(RunError::StateTooLarge { discs, bytes, limit: max_message_bytes });
+    for material in job.materials() {
+        if let MaterialSection::Dem { assembly } = material {
+            let discs = assembly.disc_count_hint();
+            let bytes = cosdem_dem::spec::state_bytes(discs);
+            if bytes > max_message_bytes as u64 {
+                return Err(RunError::StateTooLarge { discs, bytes, limit: max_message_bytes });
+            }
         }
     }
     use cosdem_job::admission::{MeshCounts, estimate};
@@ -175,54 +182,6 @@ pub fn gauss_point_ids(solver: &Solver) -> Vec<GaussPointId> {
     (0..solver.model().mesh.n_elements() as u32)
         .flat_map(|e| (0..per_element).map(move |p| GaussPointId::new(e, p)))
         .collect()
-}
-
-/// What answers at the Gauss points, and how many workers serve it (0 for an analytical
-/// material). A DEM job gets a pool (remote workers when `workers.addresses` is non-empty,
-/// else the job's `[workers] in_process` in-process workers) with one assembly per point.
-///
-/// `saved` (a resume) places those committed states instead of building new assemblies.
-pub fn material_for(
-    job: &Job,
-    workers: &WorkerChoice,
-    ids: &[GaussPointId],
-    saved: Option<Vec<AssemblyState>>,
-) -> Result<(Box<dyn Material>, usize), RunError> {
-    match &job.material {
-        MaterialSection::Elastic { .. } => {
-            let m = job.elastic().expect("an elastic job has an elastic material");
-            Ok((Box::new(m), 0))
-        }
-        MaterialSection::Dem { assembly } => {
-            // `dns:NAME:PORT` (a headless service) is the same as `NAME:PORT`: every address
-            // the name resolves to becomes a worker.
-            let addresses: Vec<String> = workers
-                .addresses
-                .iter()
-                .map(|a| a.strip_prefix("dns:").unwrap_or(a).to_string())
-                .collect();
-            let mut pool = if addresses.is_empty() {
-                let n = Pool::in_process_workers(job.workers.in_process);
-                Pool::in_process(n, workers.config.clone(), |_| Dem)?
-            } else {
-                Pool::connect(&addresses, workers.config.clone())?
-            };
-            // The disc count from the spec, so that a worker checks its limits before
-            // building and the pool splits and times its requests by it.
-            let request = AssemblyRequest {
-                spec_json: serde_json::to_vec(assembly)?,
-                boundary: BoundaryKind::Unspecified,
-                disc_count_hint: assembly.disc_count_hint(),
-            };
-            match saved {
-                // Resume: the assemblies as committed at the checkpoint.
-                Some(states) => pool.restore_states(states).map_err(cosdem_fem::Error::from)?,
-                None => pool.create_assemblies(ids, &request)?,
-            }
-            let n = pool.live_workers();
-            Ok((Box::new(pool), n))
-        }
-    }
 }
 
 /// Runs `job` into `dir` (created) and returns the final summary and curve: a plain

@@ -1,6 +1,7 @@
-//! From the records of any format to a [`RawMesh`]: duplicate elements of format 2.2 merged,
-//! nodes checked and renumbered, quadrilaterals oriented counter-clockwise, and the points and
-//! lines of physical groups turned into node and edge groups.
+//! From the records of any format to a [`RawMesh`]: duplicate elements of format 2.2 merged
+//! (their physical surfaces united), nodes checked and renumbered, quadrilaterals oriented
+//! counter-clockwise, and the points and lines of physical groups turned into node and edge
+//! groups.
 
 use super::records::{ElemRec, NodeRec, type_info};
 use super::{GmshError, QuadKind, RawElement, RawMesh, Result, structure};
@@ -48,10 +49,12 @@ pub(super) fn assemble(
     };
 
     // Format 2.2 repeats an element, under a new tag, once per physical group it belongs to:
-    // an element is identified by its type and nodes, and keeps its first tag.
-    // Quadrilaterals by element tag.
-    let mut quads: BTreeMap<u64, (QuadKind, Vec<u64>, Option<String>, usize)> = BTreeMap::new();
-    let mut quad_seen: HashSet<(u32, Vec<u64>)> = HashSet::new();
+    // an element is identified by its type and nodes, keeps its first tag, and belongs to the
+    // union of the physical surfaces of its copies (in file order).
+    // Quadrilaterals by element tag: kind, node tags, physical surfaces, line.
+    let mut quads: BTreeMap<u64, (QuadKind, Vec<u64>, Vec<String>, usize)> = BTreeMap::new();
+    // (type, node tags) -> the first tag of that element.
+    let mut quad_seen: HashMap<(u32, Vec<u64>), u64> = HashMap::new();
     // Group name -> element tag -> (gmsh type, node tags), and the elements already in it.
     let mut groups: BTreeMap<String, BTreeMap<u64, (u32, Vec<u64>)>> = BTreeMap::new();
     let mut group_seen: HashSet<(String, u32, Vec<u64>)> = HashSet::new();
@@ -90,8 +93,20 @@ pub(super) fn assemble(
             }
         }
         if let Some(kind) = QuadKind::from_gmsh_type(e.gmsh_type) {
-            let physical = e.physicals.first().map(|&p| group_name(2, p));
-            if !quad_seen.insert((e.gmsh_type, e.nodes.clone())) {
+            let mut physicals: Vec<String> = Vec::with_capacity(e.physicals.len());
+            for &p in &e.physicals {
+                let name = group_name(2, p);
+                if !physicals.contains(&name) {
+                    physicals.push(name);
+                }
+            }
+            if let Some(first) = quad_seen.get(&(e.gmsh_type, e.nodes.clone())) {
+                let known = &mut quads.get_mut(first).expect("a seen element is kept").2;
+                for name in physicals {
+                    if !known.contains(&name) {
+                        known.push(name);
+                    }
+                }
                 continue;
             }
             if quads.contains_key(&e.tag) {
@@ -101,7 +116,8 @@ pub(super) fn assemble(
                     message: format!("element tag {} is used twice", e.tag),
                 });
             }
-            quads.insert(e.tag, (kind, e.nodes, physical, e.line));
+            quad_seen.insert((e.gmsh_type, e.nodes.clone()), e.tag);
+            quads.insert(e.tag, (kind, e.nodes, physicals, e.line));
             continue;
         }
         match (e.dim, e.gmsh_type) {
@@ -143,7 +159,7 @@ pub(super) fn assemble(
     let mesh_nodes: Vec<[f64; 2]> = used.iter().map(|t| by_tag[t]).collect();
 
     let mut out_elements = Vec::with_capacity(quads.len());
-    for (tag, (kind, tags, physical, line)) in quads {
+    for (tag, (kind, tags, physicals, line)) in quads {
         let mut nodes: Vec<usize> = tags.iter().map(|t| index[t]).collect();
         let corners = [0, 1, 2, 3].map(|i| mesh_nodes[nodes[i]]);
         let area = corner_area(corners);
@@ -163,7 +179,7 @@ pub(super) fn assemble(
         if area < 0.0 {
             nodes = (0..kind.node_count()).map(|i| nodes[MIRROR[i]]).collect();
         }
-        out_elements.push(RawElement { kind, nodes, physical });
+        out_elements.push(RawElement { kind, nodes, physicals });
     }
 
     let mut node_groups = BTreeMap::new();

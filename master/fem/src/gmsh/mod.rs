@@ -17,7 +17,10 @@
 //! (e.g. the centre point of a circle arc) are dropped. Elements keep increasing tag order.
 //! A physical group without a name in `$PhysicalNames` is named by its number (`"7"`).
 //! Format 2.2 repeats an element once per physical group it belongs to (under new tags); each
-//! element is read once, and an element in several physical surfaces takes the first one.
+//! element is read once (the same type and node list is the same element, under its first
+//! tag) and keeps every physical surface of its copies, in file order
+//! ([`RawElement::physicals`]). Format 4.1 gives an element the physical surfaces of its
+//! entity, in the order `$Entities` lists them.
 //! Every node must lie in the plane z = 0 (to within 1e-12 relative to its distance from the
 //! origin).
 //!
@@ -26,6 +29,7 @@
 //! records of `records`, which `build` turns into a [`RawMesh`].
 //!
 //! [`RawMesh`]: crate::gmsh::RawMesh
+//! [`RawElement::physicals`]: crate::gmsh::RawElement::physicals
 //! [`RawMesh::node_groups`]: crate::gmsh::RawMesh::node_groups
 //! [`RawMesh::edge_groups`]: crate::gmsh::RawMesh::edge_groups
 //! [`QuadKind::Q8`]: crate::gmsh::QuadKind::Q8
@@ -237,8 +241,9 @@ pub struct RawElement {
     /// 0-based node indices into [`RawMesh::nodes`], in Gmsh order: corners 0-3
     /// counter-clockwise, mid-edge nodes 4 (0-1), 5 (1-2), 6 (2-3), 7 (3-0), centre 8 (Q9).
     pub nodes: Vec<usize>,
-    /// Name of the physical surface the element belongs to, if any.
-    pub physical: Option<String>,
+    /// Names of every physical surface the element belongs to, in file order, each once
+    /// (empty: none). An element may be in several.
+    pub physicals: Vec<String>,
 }
 
 /// A mesh as read from a `.msh` file, before any finite-element structure is built.
@@ -330,7 +335,7 @@ mod tests {
         let m = parse_msh(CLOCKWISE).unwrap();
         let e = &m.elements[0];
         assert_eq!(e.kind, QuadKind::Q8);
-        assert_eq!(e.physical, None);
+        assert!(e.physicals.is_empty());
         // Corners 1 4 3 2 (tags), mid-edge 8 7 6 5 (tags), 0-based.
         assert_eq!(e.nodes, vec![0, 3, 2, 1, 7, 6, 5, 4]);
         let c = [0, 1, 2, 3].map(|i| m.nodes[e.nodes[i]]);

@@ -12,10 +12,12 @@ use cosdem_common::{GaussPointId, MacroDeformation, MicroResponse};
 
 mod elastic;
 mod failing;
+mod regions;
 mod softening;
 
 pub use elastic::ElasticCosserat;
 pub use failing::FailureInjector;
+pub use regions::{Regions, RegionsError};
 pub use softening::SofteningElastic;
 
 /// Identifies one trial evaluation: load step and Newton iteration within it.

@@ -1,4 +1,4 @@
-//! The macro mesh: nodes, quadratic quadrilaterals and named node and edge sets.
+//! The macro mesh: nodes, quadratic quadrilaterals and named node, edge and element sets.
 //!
 //! Every mesh, structured or read from a file, goes through [`Mesh::from_description`]: the
 //! Gmsh reader only has to fill a [`MeshDescription`].
@@ -28,6 +28,9 @@ pub struct MeshDescription {
     /// type 8 order); orientation does not matter. Their nodes also form a node set of the
     /// same name.
     pub edge_groups: BTreeMap<String, Vec<[usize; 3]>>,
+    /// Named element groups (Gmsh physical surfaces), as 0-based indices into `elements`. An
+    /// element may be in several groups, or in none.
+    pub element_groups: BTreeMap<String, Vec<usize>>,
 }
 
 /// One element edge on a named boundary.
@@ -53,6 +56,9 @@ pub struct Mesh {
     pub node_sets: BTreeMap<String, Vec<usize>>,
     /// Named boundary edge sets, for tractions.
     pub edge_sets: BTreeMap<String, Vec<BoundaryEdge>>,
+    /// Named element sets (sorted, unique element indices), e.g. the regions of different
+    /// materials.
+    pub element_sets: BTreeMap<String, Vec<usize>>,
 }
 
 fn invalid(field: &'static str, value: impl ToString, reason: impl ToString) -> Error {
@@ -66,9 +72,11 @@ impl Mesh {
     /// Builds and checks a mesh from a raw description.
     ///
     /// Elements given clockwise are renumbered counter-clockwise; edge groups are matched to
-    /// the element that owns them and oriented counter-clockwise around it.
+    /// the element that owns them and oriented counter-clockwise around it. Element groups
+    /// become sorted, unique element sets; an index past the last element is an error naming
+    /// the group.
     pub fn from_description(desc: MeshDescription) -> Result<Self> {
-        let MeshDescription { nodes, elements, node_groups, edge_groups } = desc;
+        let MeshDescription { nodes, elements, node_groups, edge_groups, element_groups } = desc;
         let first = elements.first().ok_or_else(|| invalid("elements", 0, "no elements"))?;
         if elements.len() > MAX_ELEMENTS {
             return Err(invalid(
@@ -161,7 +169,20 @@ impl Mesh {
             set.sort_unstable();
             set.dedup();
         }
-        Ok(Self { nodes, kind, connectivity, node_sets, edge_sets })
+        let mut element_sets = BTreeMap::new();
+        for (name, mut group) in element_groups {
+            if let Some(&bad) = group.iter().find(|&&e| e >= elements.len()) {
+                return Err(invalid(
+                    "element_groups",
+                    &name,
+                    format!("element {bad} >= {}", elements.len()),
+                ));
+            }
+            group.sort_unstable();
+            group.dedup();
+            element_sets.insert(name, group);
+        }
+        Ok(Self { nodes, kind, connectivity, node_sets, edge_sets, element_sets })
     }
 
     /// Number of elements.
@@ -202,12 +223,22 @@ impl Mesh {
             known: self.edge_sets.keys().cloned().collect::<Vec<_>>().join(", "),
         })
     }
+
+    /// A named element set (sorted element indices).
+    pub fn element_set(&self, name: &str) -> Result<&[usize]> {
+        self.element_sets.get(name).map(Vec::as_slice).ok_or_else(|| Error::UnknownSet {
+            kind: "element",
+            name: name.to_string(),
+            known: self.element_sets.keys().cloned().collect::<Vec<_>>().join(", "),
+        })
+    }
 }
 
 impl From<crate::gmsh::RawMesh> for MeshDescription {
-    /// A Gmsh mesh as read by [`crate::gmsh`]: quadrilaterals, node groups and 3-node
-    /// boundary lines (edges of other lengths are not boundary edges of quadratic elements
-    /// and are left to the node groups).
+    /// A Gmsh mesh as read by [`crate::gmsh`]: quadrilaterals, node groups, 3-node boundary
+    /// lines (edges of other lengths are not boundary edges of quadratic elements and are
+    /// left to the node groups) and element groups from the physical surfaces (an element in
+    /// two surfaces is in both groups; whether that is allowed is for the caller to decide).
     fn from(raw: crate::gmsh::RawMesh) -> Self {
         let edge_groups = raw
             .edge_groups
@@ -220,11 +251,18 @@ impl From<crate::gmsh::RawMesh> for MeshDescription {
                 (name, edges)
             })
             .collect();
+        let mut element_groups: BTreeMap<String, Vec<usize>> = BTreeMap::new();
+        for (e, el) in raw.elements.iter().enumerate() {
+            for name in &el.physicals {
+                element_groups.entry(name.clone()).or_default().push(e);
+            }
+        }
         Self {
             nodes: raw.nodes,
             elements: raw.elements.into_iter().map(|e| e.nodes).collect(),
             node_groups: raw.node_groups,
             edge_groups,
+            element_groups,
         }
     }
 }

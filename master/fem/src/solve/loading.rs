@@ -68,10 +68,15 @@ pub struct EdgeLoad {
     pub ramp: Ramp,
 }
 
-/// Body force and body couple density `[F_x, F_y, M]` (N/m^3, N m/m^3) as a function of
-/// position, following [`Loading::body_ramp`] (`M` is ignored by the Cauchy field).
+/// Body force and body couple density `[F_x, F_y, M]` (N/m^3, N m/m^3) as a function
+/// `f(element, [x, y])` of the element and the position of a Gauss point, following
+/// [`Loading::body_ramp`] (`M` is ignored by the Cauchy field).
+///
+/// `element` is the 0-based index of the element the Gauss point lies in, as in
+/// [`Mesh::element_nodes`] and [`Mesh::element_sets`] (so each region of the mesh can have
+/// its own density); `[x, y]` is the Gauss point's position (m).
 #[derive(Clone)]
-pub struct BodyLoad(pub Arc<dyn Fn([f64; 2]) -> [f64; 3] + Send + Sync>);
+pub struct BodyLoad(pub Arc<dyn Fn(usize, [f64; 2]) -> [f64; 3] + Send + Sync>);
 
 impl fmt::Debug for BodyLoad {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -80,8 +85,8 @@ impl fmt::Debug for BodyLoad {
 }
 
 impl BodyLoad {
-    /// Wraps a density function.
-    pub fn new(f: impl Fn([f64; 2]) -> [f64; 3] + Send + Sync + 'static) -> Self {
+    /// Wraps a density function `f(element, [x, y])`.
+    pub fn new(f: impl Fn(usize, [f64; 2]) -> [f64; 3] + Send + Sync + 'static) -> Self {
         Self(Arc::new(f))
     }
 }
@@ -284,8 +289,9 @@ impl Loading {
         if let Some(body) = &self.body {
             let (fc, fl) = ramp_factors(self.body_ramp);
             for g in 0..gauss.len() {
-                let f = (body.0)(gauss.x[g]);
-                let el = mesh.element_nodes(g / gauss.per_element);
+                let element = g / gauss.per_element;
+                let f = (body.0)(element, gauss.x[g]);
+                let el = mesh.element_nodes(element);
                 for (a, &node) in el.iter().enumerate() {
                     let s = gauss.shape(g)[a] * gauss.weight[g];
                     for c in 0..ndf {
