@@ -101,6 +101,33 @@ fn nine_node_mesh_uses_biquadratic_quads() {
     assert!(bad.to_string().contains("element 0 has 5 nodes"), "{bad}");
 }
 
+/// Two 6-node triangles of a unit square (corners 0-2-8 and 0-8-6 of a 3 x 3 grid, mid-sides
+/// 0-1, 1-2, 2-0 after the corners, Gmsh's order and VTK's): written as
+/// `VTK_QUADRATIC_TRIANGLE` (22) with the node lists as given, ASCII and zlib alike, and read
+/// back by the crate's own reader with the same cells.
+#[test]
+fn six_node_triangles_are_quadratic_triangles() {
+    use cosdem_app::output::vtk::{Encoding, write_vtu_encoded};
+    let nodes: Vec<[f64; 2]> =
+        (0..9).map(|i| [0.5 * (i % 3) as f64, 0.5 * (i / 3) as f64]).collect();
+    let elements = vec![vec![0, 2, 8, 1, 5, 4], vec![0, 8, 6, 4, 7, 3]];
+    let dofs: Vec<[f64; 3]> = nodes.iter().map(|p| [0.0, -1e-3 * p[1], 0.0]).collect();
+    let dir = scratch("vtk-t6");
+    for (name, encoding) in [("t6.vtu", Encoding::Ascii), ("t6z.vtu", Encoding::Zlib)] {
+        let path = dir.join(name);
+        let piece = nodal_piece(&path, &nodes, &elements, &dofs).unwrap();
+        write_vtu_encoded(&path, &piece, encoding).unwrap();
+        let back = cosdem_app::output::vtu_read::read_vtu(&path).unwrap();
+        assert_eq!(back.cells, piece.cells, "{name}");
+        assert!(back.cells.iter().all(|c| c.cell_type == CellType::QuadraticTriangle));
+        if encoding == Encoding::Ascii {
+            let (conn, types) = cells(grid_piece(&read_vtu(&path)));
+            assert_eq!(types, [22, 22]);
+            assert_eq!(conn, elements);
+        }
+    }
+}
+
 #[test]
 fn gauss_point_cloud() {
     let positions: Vec<[f64; 2]> =

@@ -35,7 +35,7 @@
 
 /// From nodal fields to Gauss-point kinematics and back to global residual and tangent.
 pub mod assembly;
-/// Reference elements: Q8/Q9 shape functions and Gauss rules.
+/// Reference elements: Q8/Q9/T6 shape functions, Gauss rules and shape checks.
 pub mod element;
 /// The crate's error type.
 pub mod error;

@@ -17,6 +17,7 @@
 
 use crate::schema::{ElementChoice, Integration, Job, MaterialSection, MeshKind};
 use cosdem_dem::PackingSpec;
+use cosdem_fem::element::{ElementKind, Quadrature, QuadratureRule};
 use cosdem_fem::mesh::Mesh;
 use std::fmt::Write;
 
@@ -99,8 +100,11 @@ pub struct MeshCounts {
     pub elements: f64,
     /// Nodes.
     pub nodes: f64,
-    /// Nodes per element (8 or 9).
+    /// Nodes per element (8, 9 or 6).
     pub nodes_per_element: f64,
+    /// The element family: it sets the Gauss points per element
+    /// ([`MeshCounts::points_per_element`]).
+    pub kind: ElementKind,
 }
 
 impl MeshCounts {
@@ -115,12 +119,14 @@ impl MeshCounts {
         let (_, _, nx, ny) = m.symmetry.reduce_rectangle(1.0, 1.0, nx, ny);
         let (nx, ny) = (nx as f64, ny as f64);
         let grid = (2.0 * nx + 1.0) * (2.0 * ny + 1.0);
-        Some(match m.element {
-            ElementChoice::Q8 => {
-                Self { elements: nx * ny, nodes: grid - nx * ny, nodes_per_element: 8.0 }
-            }
-            ElementChoice::Q9 => Self { elements: nx * ny, nodes: grid, nodes_per_element: 9.0 },
-        })
+        // Q8 lacks the cells' centres; Q9 has every node of the (2 nx + 1) x (2 ny + 1) grid;
+        // T6 too (a cell's diagonal has its mid-side at the centre), in two triangles a cell.
+        let (elements, nodes, kind) = match m.element {
+            ElementChoice::Q8 => (nx * ny, grid - nx * ny, ElementKind::Q8),
+            ElementChoice::Q9 => (nx * ny, grid, ElementKind::Q9),
+            ElementChoice::T6 => (2.0 * nx * ny, grid, ElementKind::T6),
+        };
+        Some(Self { elements, nodes, nodes_per_element: kind.nodes() as f64, kind })
     }
 
     /// The counts of a built mesh.
@@ -129,7 +135,16 @@ impl MeshCounts {
             elements: mesh.n_elements() as f64,
             nodes: mesh.n_nodes() as f64,
             nodes_per_element: mesh.kind.nodes() as f64,
+            kind: mesh.kind,
         }
+    }
+
+    /// Gauss points per element under `integration`: those of the rule the solver takes
+    /// ([`QuadratureRule::for_kind`]), 4 (`reduced`, 2 x 2) or 9 (`full`, 3 x 3) per
+    /// quadrilateral, 3 or 6 per triangle.
+    pub fn points_per_element(&self, integration: Integration) -> f64 {
+        let rule = QuadratureRule::for_kind(self.kind, integration == Integration::Full);
+        Quadrature::new(rule).len() as f64
     }
 }
 
@@ -222,8 +237,12 @@ fn mesh_keys(job: &Job) -> Vec<String> {
             m.file.as_deref().unwrap_or(std::path::Path::new("")).display().to_string()
         )],
     };
-    if m.element == ElementChoice::Q9 && m.kind == MeshKind::Rectangle {
-        keys.push("mesh.element = \"q9\"".into());
+    if m.kind == MeshKind::Rectangle {
+        match m.element {
+            ElementChoice::Q8 => {}
+            ElementChoice::Q9 => keys.push("mesh.element = \"q9\"".into()),
+            ElementChoice::T6 => keys.push("mesh.element = \"t6\"".into()),
+        }
     }
     keys
 }
@@ -264,10 +283,7 @@ fn packing_keys(p: &PackingSpec) -> Vec<String> {
 /// allocated. No file is read; the one input besides the job is the number of cores when
 /// `[workers] in_process = 0` (random packings built at once).
 pub fn estimate(job: &Job, mesh: MeshCounts) -> Estimate {
-    let points_per_element = match job.mesh.integration {
-        Integration::Reduced => 4.0,
-        Integration::Full => 9.0,
-    };
+    let points_per_element = mesh.points_per_element(job.mesh.integration);
     let gauss_points = mesh.elements * points_per_element;
     let mut point_keys = mesh_keys(job);
     if job.mesh.integration == Integration::Full {

@@ -71,6 +71,7 @@ impl Job {
                 let kind = match m.element {
                     ElementChoice::Q8 => ElementKind::Q8,
                     ElementChoice::Q9 => ElementKind::Q9,
+                    ElementChoice::T6 => ElementKind::T6,
                 };
                 // validate() made sure these are present.
                 let (lx, ly, nx, ny) = m.symmetry.reduce_rectangle(
@@ -142,12 +143,10 @@ impl Job {
         self.loading.compression.as_ref().map_or(0.0, |c| c.displacement)
     }
 
-    /// The Gauss rule.
-    pub fn rule(&self) -> QuadratureRule {
-        match self.mesh.integration {
-            Integration::Reduced => QuadratureRule::Gauss2x2,
-            Integration::Full => QuadratureRule::Gauss3x3,
-        }
+    /// The Gauss rule of `integration` on elements of `kind`: 2x2 (`reduced`) or 3x3 (`full`)
+    /// points on a quadrilateral, 3 or 6 on a triangle.
+    pub fn rule(&self, kind: ElementKind) -> QuadratureRule {
+        QuadratureRule::for_kind(kind, self.mesh.integration == Integration::Full)
     }
 
     /// The FE model: mesh, field, rule, loading. Checks the sets the job names and the
@@ -180,7 +179,8 @@ impl Job {
             }
             false => self.loading(),
         };
-        Ok(cosdem_fem::solve::Model { mesh, field: self.field(), rule: self.rule(), loading })
+        let rule = self.rule(mesh.kind);
+        Ok(cosdem_fem::solve::Model { mesh, field: self.field(), rule, loading })
     }
 
     /// Newton and step settings.

@@ -53,7 +53,7 @@ pub struct Job {
 pub enum MeshKind {
     /// A structured rectangle `lx` x `ly` with `nx` x `ny` elements.
     Rectangle,
-    /// A Gmsh `.msh` file (2.2 or 4.1) of 8- or 9-node quadrilaterals.
+    /// A Gmsh `.msh` file (2.2 or 4.1) of 8- or 9-node quadrilaterals or 6-node triangles.
     Gmsh,
 }
 
@@ -65,15 +65,18 @@ pub enum ElementChoice {
     Q8,
     /// 9-node Lagrange quadrilateral.
     Q9,
+    /// 6-node quadratic triangle: each cell of the rectangle's grid split into two.
+    T6,
 }
 
 /// Gauss rule.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Integration {
-    /// 2x2 points per element (the paper's; one DEM assembly per point).
+    /// 2x2 points per quadrilateral (the paper's; one DEM assembly per point), 3 per
+    /// triangle.
     Reduced,
-    /// 3x3 points per element.
+    /// 3x3 points per quadrilateral, 6 per triangle.
     Full,
 }
 
@@ -104,10 +107,10 @@ pub struct MeshSection {
     /// Lower-left corner (m), rectangle only; default `[0, 0]`.
     #[serde(default, deserialize_with = "crate::arrays::origin")]
     pub origin: [f64; 2],
-    /// `q8` (default) or `q9`, rectangle only (a Gmsh file says its own).
+    /// `q8` (default), `q9` or `t6`, rectangle only (a Gmsh file says its own).
     #[serde(default = "default_element")]
     pub element: ElementChoice,
-    /// `reduced` (2x2, default) or `full` (3x3).
+    /// `reduced` (2x2 or 3 per triangle, default) or `full` (3x3 or 6 per triangle).
     #[serde(default = "default_integration")]
     pub integration: Integration,
     /// `cosserat` (default) or `cauchy`.

@@ -2,7 +2,7 @@
 //! the job file and the value ([`Error::InvalidSetting`]); numbers are printed with `{:?}`, so
 //! that `1e308` reads `1e308` and not as 309 digits.
 
-use crate::schema::{Job, MaterialSection, MeshKind, Moving};
+use crate::schema::{ElementChoice, Job, MaterialSection, MeshKind, Moving};
 use cosdem_fem::error::{Error, Result};
 use cosdem_fem::mesh::MAX_ELEMENTS;
 use cosdem_fem::solve::{MAX_LOAD_STEPS, MIN_INCREMENT_FRACTION};
@@ -167,6 +167,13 @@ impl Job {
                         "mesh.nx",
                         format!("{nx} (with mesh.ny = {ny})"),
                         "nx * ny must be at most MAX_ELEMENTS = 1 000 000 elements",
+                    ));
+                }
+                if m.element == ElementChoice::T6 && nx.saturating_mul(ny) > MAX_ELEMENTS / 2 {
+                    return Err(bad(
+                        "mesh.nx",
+                        format!("{nx} (with mesh.ny = {ny} and mesh.element = \"t6\")"),
+                        "2 * nx * ny triangles must be at most MAX_ELEMENTS = 1 000 000 elements",
                     ));
                 }
                 for v in m.origin {

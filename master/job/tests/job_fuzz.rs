@@ -287,6 +287,7 @@ fn hostile_documents_are_refused_with_the_key() {
         ("nx = 4", "nx = 9223372036854775807", "mesh.nx"),
         ("nx = 4\nny = 4", "nx = 1000000\nny = 1000000", "mesh.nx"),
         ("nx = 4\nny = 4", "nx = 1000\nny = 1001", "mesh.nx"),
+        ("nx = 4\nny = 4", "nx = 1000\nny = 501\nelement = \"t6\"", "2 * nx * ny triangles"),
         ("steps = 3", "steps = 1000000000", "loading.steps"),
         ("steps = 3", "increment = 1e-300", "loading.increment = 1e-300"),
         ("lx = 1.0", "lx = nan", "mesh.lx"),

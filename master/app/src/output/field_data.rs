@@ -19,9 +19,11 @@ pub struct FieldData {
     pub nodes: Vec<[f64; 2]>,
     /// Nodal displacements `[u_x, u_y]` (m).
     pub displacements: Vec<[f64; 2]>,
-    /// Element node lists (8 or 9 nodes, Gmsh order).
+    /// Element node lists (8 or 9 nodes of a quadrilateral, 6 of a triangle; Gmsh order).
     pub elements: Vec<Vec<usize>>,
-    /// Gauss points per element (4, 9 or 16: the tensor rule, xi running fastest).
+    /// Gauss points per element: 4, 9 or 16 on quadrilaterals (the tensor rule, xi running
+    /// fastest), 3 or 6 on triangles (the solver's triangle rule of that many points, in its
+    /// order: [`cosdem_fem::element::Quadrature`]).
     pub gauss_per_element: usize,
     /// Equivalent strain per Gauss point, element-major.
     pub equivalent_strain: Vec<f64>,
@@ -60,14 +62,56 @@ impl FieldData {
                 f.gauss_per_element
             )));
         }
-        if !matches!(f.gauss_per_element, 4 | 9 | 16) {
-            return Err(bad(format!("gauss_per_element = {}", f.gauss_per_element)));
-        }
         for (e, nodes) in f.elements.iter().enumerate() {
-            if !matches!(nodes.len(), 8 | 9) || nodes.iter().any(|&n| n >= f.nodes.len()) {
+            if !matches!(nodes.len(), 6 | 8 | 9) || nodes.iter().any(|&n| n >= f.nodes.len()) {
                 return Err(bad(format!("element {e} has the nodes {nodes:?}")));
+            }
+            let rules: &[usize] = if nodes.len() == 6 { &[3, 6] } else { &[4, 9, 16] };
+            if !rules.contains(&f.gauss_per_element) {
+                return Err(bad(format!(
+                    "gauss_per_element = {} for element {e} of {} nodes (expected {rules:?})",
+                    f.gauss_per_element,
+                    nodes.len()
+                )));
             }
         }
         Ok(f)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// One 6-node triangle (the reference triangle's nodes) with `per` Gauss values.
+    fn triangle(per: usize) -> FieldData {
+        let nodes = vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [0.5, 0.0], [0.5, 0.5], [0.0, 0.5]];
+        FieldData {
+            step: 1,
+            displacement: 0.001,
+            internal_length: 0.01,
+            displacements: vec![[0.0; 2]; 6],
+            nodes,
+            elements: vec![(0..6).collect()],
+            gauss_per_element: per,
+            equivalent_strain: vec![1e-3; per],
+        }
+    }
+
+    /// A triangle's field reads back with the triangle rules' 3 or 6 points; the
+    /// quadrilaterals' 4 points on a triangle are refused naming the count and the element.
+    #[test]
+    fn triangles_take_three_or_six_points() {
+        let dir = std::env::temp_dir().join(format!("cosdem-field-data-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("field.json");
+        for per in [3, 6] {
+            triangle(per).write(&path).unwrap();
+            assert_eq!(FieldData::read(&path).unwrap(), triangle(per));
+        }
+        triangle(4).write(&path).unwrap();
+        let e = FieldData::read(&path).unwrap_err().to_string();
+        assert!(e.contains("gauss_per_element = 4 for element 0 of 6 nodes"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

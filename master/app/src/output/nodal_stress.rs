@@ -8,7 +8,8 @@
 /// the mean of the values of the elements that contain it (each element counted once, however
 /// many times it lists the node). A node in no element gets zeros. The result is exact for a
 /// uniform field and bounded by the Gauss-point extremes everywhere (no extrapolation, so no
-/// overshoot at the boundary; a gradient is smoothed over one element).
+/// overshoot at the boundary; a gradient is smoothed over one element). It holds for any rule
+/// and element family alike: 4 or 9 points of a quadrilateral, 3 or 6 of a triangle.
 ///
 /// # Panics
 /// When `gauss` holds fewer than `per_element * elements.len()` values or an element lists a
@@ -106,5 +107,19 @@ mod tests {
         let nodal = nodal_average(6, &two_quads(), 4, &gauss);
         let got: Vec<f64> = nodal.iter().map(|v| v[0]).collect();
         assert_eq!(got, [1.0, 2.0, 3.0, 1.0, 2.0, 3.0]);
+    }
+
+    /// The rule does not depend on the element family: two 6-node triangles of a unit square
+    /// (corners 0-2-8 and 0-8-6 of a 3 x 3 grid of nodes, mid-sides in Gmsh order) with 3
+    /// Gauss points each, of means 1 (values 0, 1, 2) and 3 (values 2, 3, 4): the diagonal's
+    /// nodes 0, 4 and 8 get 2, the others their triangle's mean (exact: sums of small
+    /// integers and a division by 2 or 3 of a multiple).
+    #[test]
+    fn triangles_with_three_points_average_the_same_way() {
+        let triangles = vec![vec![0, 2, 8, 1, 5, 4], vec![0, 8, 6, 4, 7, 3]];
+        let gauss: Vec<[f64; 1]> = [0.0, 1.0, 2.0, 2.0, 3.0, 4.0].iter().map(|&v| [v]).collect();
+        let nodal = nodal_average(9, &triangles, 3, &gauss);
+        let got: Vec<f64> = nodal.iter().map(|v| v[0]).collect();
+        assert_eq!(got, [2.0, 1.0, 1.0, 3.0, 2.0, 1.0, 3.0, 3.0, 2.0]);
     }
 }

@@ -7,11 +7,12 @@ use super::{Result, invalid};
 use std::path::Path;
 
 /// The mesh with the nodal solution: one cell per element (8 nodes: `VTK_QUADRATIC_QUAD`,
-/// 9 nodes: `VTK_BIQUADRATIC_QUAD`, 4 nodes: `VTK_QUAD`; node order as in Gmsh), point arrays
+/// 9 nodes: `VTK_BIQUADRATIC_QUAD`, 6 nodes: `VTK_QUADRATIC_TRIANGLE`, 4 nodes: `VTK_QUAD`,
+/// 3 nodes: `VTK_TRIANGLE`; VTK's node order for these is Gmsh's), point arrays
 /// `displacement` (u_x, u_y, 0) and `rotation` (w) from `dofs[node] = [u_x, u_y, w]`.
 ///
-/// Errors name the first element whose node count is not 4, 8 or 9; `path` only names the
-/// file in errors. Array lengths are checked when the piece is written.
+/// Errors name the first element whose node count is not 3, 4, 6, 8 or 9; `path` only names
+/// the file in errors. Array lengths are checked when the piece is written.
 pub fn nodal_piece(
     path: &Path,
     nodes: &[[f64; 2]],
@@ -20,8 +21,8 @@ pub fn nodal_piece(
 ) -> Result<VtuPiece> {
     let mut piece = VtuPiece::from_points_2d(nodes);
     for (i, e) in elements.iter().enumerate() {
-        let cell_type = CellType::quad_with_nodes(e.len()).ok_or_else(|| {
-            invalid(path, format!("element {i} has {} nodes; expected 4, 8 or 9", e.len()))
+        let cell_type = CellType::element_with_nodes(e.len()).ok_or_else(|| {
+            invalid(path, format!("element {i} has {} nodes; expected 3, 4, 6, 8 or 9", e.len()))
         })?;
         piece.push_cell(cell_type, e.clone());
     }

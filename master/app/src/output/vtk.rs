@@ -3,8 +3,8 @@
 //! One generic [`VtuPiece`] (points, cells of any [`CellType`], named `f64` arrays with any
 //! number of components on points and cells) serves every output of the solver; the
 //! constructors below build the usual ones:
-//! - [`nodal_piece`]: the mesh of 8-/9-node quadrilaterals with `displacement` (3 components,
-//!   z = 0) and `rotation` (the micro-rotation w);
+//! - [`nodal_piece`]: the mesh of 8-/9-node quadrilaterals or 6-node triangles with
+//!   `displacement` (3 components, z = 0) and `rotation` (the micro-rotation w);
 //! - [`gauss_point_piece`]: a point cloud of the Gauss points (`VTK_VERTEX` cells) with
 //!   `strain`, `curvature`, `stress`, `couple_stress` and `equivalent_strain` (Eq. 34);
 //! - [`particle_piece`]: a DEM snapshot, one vertex per disc with `radius`, `rotation` and
@@ -14,7 +14,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use super::{OutputError, Result, invalid, push_f64, write_atomic};
-use cosdem_fem::gmsh::QuadKind;
+use cosdem_fem::gmsh::SurfaceKind;
 
 /// The VTK cell types the solver writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -29,6 +29,9 @@ pub enum CellType {
     Quad,
     /// `VTK_QUADRATIC_EDGE` (21): 3-node line, ends then middle.
     QuadraticEdge,
+    /// `VTK_QUADRATIC_TRIANGLE` (22): 6-node triangle, corners then the mid-sides of 0-1,
+    /// 1-2 and 2-0 (Gmsh's order for its type 9).
+    QuadraticTriangle,
     /// `VTK_QUADRATIC_QUAD` (23): 8-node quadrilateral, corners then mid-edge nodes.
     QuadraticQuad,
     /// `VTK_BIQUADRATIC_QUAD` (28): 9-node quadrilateral, corners, mid-edge nodes, centre.
@@ -44,6 +47,7 @@ impl CellType {
             CellType::Triangle => 5,
             CellType::Quad => 9,
             CellType::QuadraticEdge => 21,
+            CellType::QuadraticTriangle => 22,
             CellType::QuadraticQuad => 23,
             CellType::BiquadraticQuad => 28,
         }
@@ -57,6 +61,7 @@ impl CellType {
             CellType::Triangle => 3,
             CellType::Quad => 4,
             CellType::QuadraticEdge => 3,
+            CellType::QuadraticTriangle => 6,
             CellType::QuadraticQuad => 8,
             CellType::BiquadraticQuad => 9,
         }
@@ -71,13 +76,24 @@ impl CellType {
             _ => None,
         }
     }
+
+    /// The 2D element cell with `n` nodes in Gmsh order (3 or 6: a triangle; 4, 8 or 9: a
+    /// quadrilateral), if any. No two of the solver's element families share a node count.
+    pub const fn element_with_nodes(n: usize) -> Option<CellType> {
+        match n {
+            3 => Some(CellType::Triangle),
+            6 => Some(CellType::QuadraticTriangle),
+            n => Self::quad_with_nodes(n),
+        }
+    }
 }
 
-impl From<QuadKind> for CellType {
-    fn from(kind: QuadKind) -> Self {
+impl From<SurfaceKind> for CellType {
+    fn from(kind: SurfaceKind) -> Self {
         match kind {
-            QuadKind::Q8 => CellType::QuadraticQuad,
-            QuadKind::Q9 => CellType::BiquadraticQuad,
+            SurfaceKind::Q8 => CellType::QuadraticQuad,
+            SurfaceKind::Q9 => CellType::BiquadraticQuad,
+            SurfaceKind::T6 => CellType::QuadraticTriangle,
         }
     }
 }
@@ -535,12 +551,28 @@ mod tests {
 
     #[test]
     fn cell_types_match_vtk_and_gmsh() {
-        assert_eq!(CellType::from(QuadKind::Q8).vtk_id(), QuadKind::Q8.vtk_cell_type());
-        assert_eq!(CellType::from(QuadKind::Q9).vtk_id(), QuadKind::Q9.vtk_cell_type());
-        assert_eq!(CellType::from(QuadKind::Q8).node_count(), QuadKind::Q8.node_count());
-        assert_eq!(CellType::from(QuadKind::Q9).node_count(), QuadKind::Q9.node_count());
+        for kind in [SurfaceKind::Q8, SurfaceKind::Q9, SurfaceKind::T6] {
+            assert_eq!(CellType::from(kind).vtk_id(), kind.vtk_cell_type(), "{kind:?}");
+            assert_eq!(CellType::from(kind).node_count(), kind.node_count(), "{kind:?}");
+            let by_count = CellType::element_with_nodes(kind.node_count());
+            assert_eq!(by_count, Some(CellType::from(kind)), "{kind:?}");
+        }
         assert_eq!(CellType::Vertex.vtk_id(), 1);
         assert_eq!(CellType::Line.vtk_id(), 3);
+        assert_eq!(CellType::QuadraticTriangle.vtk_id(), 22);
+        assert_eq!(CellType::QuadraticTriangle.node_count(), 6);
+    }
+
+    /// Every element family of the solver has its cell, found by its node count, and the
+    /// count is the cell's.
+    #[test]
+    fn element_cells_by_node_count() {
+        for n in [3, 4, 6, 8, 9] {
+            assert_eq!(CellType::element_with_nodes(n).map(CellType::node_count), Some(n));
+        }
+        assert_eq!(CellType::element_with_nodes(6), Some(CellType::QuadraticTriangle));
+        assert_eq!(CellType::element_with_nodes(5), None);
+        assert_eq!(CellType::quad_with_nodes(6), None);
     }
 
     #[test]

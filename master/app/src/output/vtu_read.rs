@@ -145,6 +145,7 @@ fn cell_type(id: u8) -> Option<CellType> {
         CellType::Triangle,
         CellType::Quad,
         CellType::QuadraticEdge,
+        CellType::QuadraticTriangle,
         CellType::QuadraticQuad,
         CellType::BiquadraticQuad,
     ]

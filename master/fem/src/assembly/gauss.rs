@@ -1,7 +1,7 @@
 //! Mapped shape functions at every Gauss point of the mesh, computed once.
 
 use crate::element::{Quadrature, QuadratureRule, shape_at};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use cosdem_common::GaussPointId;
 
@@ -25,8 +25,22 @@ pub struct GaussData {
 }
 
 impl GaussData {
-    /// Maps `rule` onto every element; fails on an inverted element.
+    /// Maps `rule` onto every element; fails on an inverted element, and on a rule that does
+    /// not fit the mesh's elements (a square rule on triangles or the reverse: see
+    /// [`QuadratureRule::for_kind`]).
     pub fn new(mesh: &Mesh, rule: QuadratureRule) -> Result<Self> {
+        if !rule.fits(mesh.kind) {
+            return Err(Error::InvalidSetting {
+                field: "rule",
+                value: format!("{rule:?}"),
+                reason: format!(
+                    "not a rule of {:?} elements; their reduced and full rules are {:?} and {:?}",
+                    mesh.kind,
+                    QuadratureRule::for_kind(mesh.kind, false),
+                    QuadratureRule::for_kind(mesh.kind, true)
+                ),
+            });
+        }
         let q = Quadrature::new(rule);
         let nn = mesh.kind.nodes();
         let total = mesh.n_elements() * q.len();

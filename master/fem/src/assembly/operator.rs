@@ -195,7 +195,7 @@ mod tests {
             *p = [p[0] + 0.05 * (3.0 * p[1]).sin(), p[1] + 0.04 * (2.0 * p[0]).cos()];
         }
         let dofs = DofMap::new(field, mesh.n_nodes(), &vec![false; mesh.n_nodes() * field.ndf()]);
-        let gauss = GaussData::new(&mesh, QuadratureRule::Gauss3x3).unwrap();
+        let gauss = GaussData::new(&mesh, QuadratureRule::for_kind(kind, true)).unwrap();
         let pattern = Pattern::new(&mesh, &dofs);
         (mesh, dofs, gauss, pattern)
     }
@@ -207,7 +207,7 @@ mod tests {
         #[test]
         fn b_matrix_agrees_with_kinematics(seed in prop::collection::vec(-1e-2f64..1e-2, 3 * 15)) {
             for field in [Field::Cosserat, Field::Cauchy] {
-                for kind in [ElementKind::Q8, ElementKind::Q9] {
+                for kind in [ElementKind::Q8, ElementKind::Q9, ElementKind::T6] {
                     let (mesh, dofs, gauss, _) = setup(kind, field);
                     let u: Vec<f64> = (0..dofs.n_dofs()).map(|i| seed[i % seed.len()] * (1.0 + i as f64 * 0.01)).collect();
                     let op = CosseratOperator { field };
@@ -236,7 +236,7 @@ mod tests {
     fn assembled_tangent_is_the_derivative_of_the_internal_force() {
         let mut mat =
             SofteningElastic { elastic: ElasticCosserat::new(1e6, 0.3, 4e5, 0.1), beta: 300.0 };
-        for kind in [ElementKind::Q8, ElementKind::Q9] {
+        for kind in [ElementKind::Q8, ElementKind::Q9, ElementKind::T6] {
             let (mesh, dofs, gauss, pattern) = setup(kind, Field::Cosserat);
             let op = CosseratOperator { field: Field::Cosserat };
             let u: Vec<f64> =

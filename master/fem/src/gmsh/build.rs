@@ -1,18 +1,21 @@
 //! From the records of any format to a [`RawMesh`]: duplicate elements of format 2.2 merged
-//! (their physical surfaces united), nodes checked and renumbered, quadrilaterals oriented
-//! counter-clockwise, and the points and lines of physical groups turned into node and edge
-//! groups.
+//! (their physical surfaces united), nodes checked and renumbered, surface elements
+//! oriented counter-clockwise (and triangles checked for their shape), and the points and
+//! lines of physical groups turned into node and edge groups.
 
 use super::records::{ElemRec, NodeRec, type_info};
-use super::{GmshError, QuadKind, RawElement, RawMesh, Result, structure};
+use super::{GmshError, RawElement, RawMesh, Result, SurfaceKind, structure};
+use crate::element::{ElementKind, shape_defect};
 use std::collections::{BTreeMap, BTreeSet, HashMap, HashSet};
 
-/// Signed area of the corner polygon of a quadrilateral.
-pub(super) fn corner_area(c: [[f64; 2]; 4]) -> f64 {
+/// Signed area of the corner polygon of an element (3 or 4 corners).
+pub(super) fn corner_area(c: impl AsRef<[[f64; 2]]>) -> f64 {
+    let c = c.as_ref();
+    let n = c.len();
     let mut a = 0.0;
-    for i in 0..4 {
+    for i in 0..n {
         let [x0, y0] = c[i];
-        let [x1, y1] = c[(i + 1) % 4];
+        let [x1, y1] = c[(i + 1) % n];
         a += x0 * y1 - x1 * y0;
     }
     0.5 * a
@@ -20,6 +23,31 @@ pub(super) fn corner_area(c: [[f64; 2]; 4]) -> f64 {
 
 /// Node permutation that mirrors a clockwise quadrilateral into a counter-clockwise one.
 const MIRROR: [usize; 9] = [0, 3, 2, 1, 7, 6, 5, 4, 8];
+
+/// Node permutation that mirrors a clockwise 6-node triangle into a counter-clockwise one.
+const MIRROR_TRIANGLE: [usize; 6] = [0, 2, 1, 5, 4, 3];
+
+/// The hint of an unsupported element type: first-order triangles and quadrangles are to be
+/// meshed second order.
+fn hint(gmsh_type: u32) -> &'static str {
+    match gmsh_type {
+        2 => {
+            "first-order triangles cannot carry the solver's quadratic fields: mesh second \
+             order (`Mesh.ElementOrder = 2;` in the .geo file, or `gmsh -order 2`) to get \
+             6-node triangles (type 9)"
+        }
+        3 => {
+            "first-order quadrangles cannot carry the solver's quadratic fields: mesh second \
+             order (`Mesh.ElementOrder = 2;` in the .geo file, or `gmsh -order 2`; add \
+             `Mesh.SecondOrderIncomplete = 1;` for 8-node quadrangles)"
+        }
+        _ => {
+            "2D meshes must consist of 6-node triangles (type 9) or of 8-node (type 16) or \
+             9-node (type 10) quadrilaterals, and boundary groups of 2- or 3-node lines \
+             (types 1, 8) or points (type 15)"
+        }
+    }
+}
 
 /// Checks the records against each other and builds the [`RawMesh`]: duplicate nodes and
 /// element tags, node counts per type, unknown node tags and degenerate quadrilaterals are
@@ -52,7 +80,7 @@ pub(super) fn assemble(
     // an element is identified by its type and nodes, keeps its first tag, and belongs to the
     // union of the physical surfaces of its copies (in file order).
     // Quadrilaterals by element tag: kind, node tags, physical surfaces, line.
-    let mut quads: BTreeMap<u64, (QuadKind, Vec<u64>, Vec<String>, usize)> = BTreeMap::new();
+    let mut quads: BTreeMap<u64, (SurfaceKind, Vec<u64>, Vec<String>, usize)> = BTreeMap::new();
     // (type, node tags) -> the first tag of that element.
     let mut quad_seen: HashMap<(u32, Vec<u64>), u64> = HashMap::new();
     // Group name -> element tag -> (gmsh type, node tags), and the elements already in it.
@@ -67,6 +95,7 @@ pub(super) fn assemble(
             element: e.tag,
             element_type: e.gmsh_type,
             name: info.map_or("unknown type", |i| i.0),
+            hint: hint(e.gmsh_type),
         };
         if let Some((name, _, count)) = info
             && e.nodes.len() != count
@@ -92,7 +121,7 @@ pub(super) fn assemble(
                 });
             }
         }
-        if let Some(kind) = QuadKind::from_gmsh_type(e.gmsh_type) {
+        if let Some(kind) = SurfaceKind::from_gmsh_type(e.gmsh_type) {
             let mut physicals: Vec<String> = Vec::with_capacity(e.physicals.len());
             for &p in &e.physicals {
                 let name = group_name(2, p);
@@ -140,9 +169,26 @@ pub(super) fn assemble(
     if quads.is_empty() {
         return Err(structure(
             file,
-            "no 8-node (type 16) or 9-node (type 10) quadrilaterals: mesh with `-order 2` \
-             and recombine the surfaces",
+            "no 6-node triangles (type 9) or 8-node (type 16) or 9-node (type 10) \
+             quadrilaterals: mesh with `-order 2` (and recombine the surfaces for \
+             quadrilaterals)",
         ));
+    }
+    // One family per mesh, for now: the first element (smallest tag) sets it.
+    let mut families = quads.iter().map(|(&tag, q)| (tag, q.0, q.3));
+    if let Some((first, first_kind, _)) = families.next()
+        && let Some((other, other_kind, line)) =
+            families.find(|f| f.1.is_triangle() != first_kind.is_triangle())
+    {
+        let name = |k: SurfaceKind| type_info(k.gmsh_type()).map_or("?", |i| i.0);
+        return Err(GmshError::MixedElements {
+            file: file.to_string(),
+            line,
+            first,
+            first_name: name(first_kind),
+            other,
+            other_name: name(other_kind),
+        });
     }
 
     // Renumber the used nodes by increasing tag.
@@ -161,11 +207,12 @@ pub(super) fn assemble(
     let mut out_elements = Vec::with_capacity(quads.len());
     for (tag, (kind, tags, physicals, line)) in quads {
         let mut nodes: Vec<usize> = tags.iter().map(|t| index[t]).collect();
-        let corners = [0, 1, 2, 3].map(|i| mesh_nodes[nodes[i]]);
-        let area = corner_area(corners);
+        let nc = kind.corner_count();
+        let corners: Vec<[f64; 2]> = nodes[..nc].iter().map(|&n| mesh_nodes[n]).collect();
+        let area = corner_area(&corners);
         let mut size: f64 = 0.0;
-        for i in 0..4 {
-            let (a, b) = (corners[i], corners[(i + 1) % 4]);
+        for i in 0..nc {
+            let (a, b) = (corners[i], corners[(i + 1) % nc]);
             size = size.max((b[0] - a[0]).hypot(b[1] - a[1]));
         }
         if !area.is_finite() || area.abs() <= 1e-12 * size * size {
@@ -177,7 +224,19 @@ pub(super) fn assemble(
             });
         }
         if area < 0.0 {
-            nodes = (0..kind.node_count()).map(|i| nodes[MIRROR[i]]).collect();
+            let mirror: &[usize] = if kind.is_triangle() { &MIRROR_TRIANGLE } else { &MIRROR };
+            nodes = (0..kind.node_count()).map(|i| nodes[mirror[i]]).collect();
+        }
+        if kind.is_triangle() {
+            let coords: Vec<[f64; 2]> = nodes.iter().map(|&n| mesh_nodes[n]).collect();
+            if let Some(reason) = shape_defect(ElementKind::T6, &coords) {
+                return Err(GmshError::DistortedElement {
+                    file: file.to_string(),
+                    line,
+                    element: tag,
+                    reason,
+                });
+            }
         }
         out_elements.push(RawElement { kind, nodes, physicals });
     }

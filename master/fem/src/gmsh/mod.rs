@@ -1,14 +1,18 @@
-//! Gmsh `.msh` reader for meshes of 8- and 9-node quadrilaterals.
+//! Gmsh `.msh` reader for meshes of 8- and 9-node quadrilaterals or 6-node triangles.
 //!
 //! Reads the ASCII formats 2.2 (`gmsh -format msh22`) and 4.1 (`-format msh41`, Gmsh's
 //! default), and binary 4.1 (`-format msh41 -bin`), into a [`RawMesh`]: node coordinates,
-//! quadrilateral connectivity and the named physical groups, with no finite-element types.
+//! element connectivity and the named physical groups, with no finite-element types.
 //!
 //! What is kept:
-//! - 2D elements of Gmsh type 16 (8-node serendipity, [`QuadKind::Q8`]) and type 10 (9-node
-//!   Lagrange, [`QuadKind::Q9`]). Any other 2D or 3D element type is an error naming the type.
-//!   Corner order is made counter-clockwise: an element whose corners turn clockwise is
-//!   mirrored (corners `0 3 2 1`, mid-edge nodes `7 6 5 4`, centre stays).
+//! - 2D elements of Gmsh type 16 (8-node serendipity, [`SurfaceKind::Q8`]), type 10 (9-node
+//!   Lagrange, [`SurfaceKind::Q9`]) and type 9 (6-node triangle, [`SurfaceKind::T6`]). Any
+//!   other 2D or 3D element type is an error naming the type (a first-order 3-node triangle
+//!   or 4-node quadrangle with the hint to mesh with `Mesh.ElementOrder = 2`). A mesh of
+//!   triangles and quadrilaterals together is refused for now
+//!   ([`GmshError::MixedElements`]). Corner order is made counter-clockwise: an element whose
+//!   corners turn clockwise is mirrored (quadrilaterals: corners `0 3 2 1`, mid-edge nodes
+//!   `7 6 5 4`, centre stays; triangles: corners `0 2 1`, mid-side nodes `5 4 3`).
 //! - 0D and 1D elements (points, 2- and 3-node lines) that belong to a physical group: their
 //!   nodes form [`RawMesh::node_groups`], and 3-node lines form [`RawMesh::edge_groups`].
 //!   Points and lines without a physical group are ignored.
@@ -32,8 +36,10 @@
 //! [`RawElement::physicals`]: crate::gmsh::RawElement::physicals
 //! [`RawMesh::node_groups`]: crate::gmsh::RawMesh::node_groups
 //! [`RawMesh::edge_groups`]: crate::gmsh::RawMesh::edge_groups
-//! [`QuadKind::Q8`]: crate::gmsh::QuadKind::Q8
-//! [`QuadKind::Q9`]: crate::gmsh::QuadKind::Q9
+//! [`SurfaceKind::Q8`]: crate::gmsh::SurfaceKind::Q8
+//! [`SurfaceKind::Q9`]: crate::gmsh::SurfaceKind::Q9
+//! [`SurfaceKind::T6`]: crate::gmsh::SurfaceKind::T6
+//! [`GmshError::MixedElements`]: crate::gmsh::GmshError::MixedElements
 
 mod ascii;
 mod binary;
@@ -110,9 +116,7 @@ pub enum GmshError {
     },
     /// An element type that the solver cannot use.
     #[error(
-        "{file}:{line}: element {element} has unsupported Gmsh type {element_type} ({name}); \
-         2D meshes must consist of 8-node (type 16) or 9-node (type 10) quadrilaterals, and \
-         boundary groups of 2- or 3-node lines (types 1, 8) or points (type 15)"
+        "{file}:{line}: element {element} has unsupported Gmsh type {element_type} ({name}); {hint}"
     )]
     UnsupportedElement {
         /// The file.
@@ -125,6 +129,41 @@ pub enum GmshError {
         element_type: u32,
         /// Gmsh's description of that type.
         name: &'static str,
+        /// What to do instead: for a first-order triangle or quadrangle, mesh with
+        /// `Mesh.ElementOrder = 2`; otherwise the element types the solver takes.
+        hint: &'static str,
+    },
+    /// Triangles and quadrilaterals in one mesh (not supported yet).
+    #[error(
+        "{file}:{line}: mixed meshes are not supported yet: element {first} is a \
+         {first_name}, element {other} a {other_name}"
+    )]
+    MixedElements {
+        /// The file.
+        file: String,
+        /// 1-based line of element `other`.
+        line: usize,
+        /// Gmsh tag of the first element of the mesh's first family.
+        first: u64,
+        /// Its Gmsh description (`6-node triangle`, ...).
+        first_name: &'static str,
+        /// Gmsh tag of the first element of the other family.
+        other: u64,
+        /// Its Gmsh description.
+        other_name: &'static str,
+    },
+    /// An element whose shape the solver cannot use: a mid-side node far off its edge or a
+    /// non-positive Jacobian (see [`crate::element::shape_defect`]; triangles).
+    #[error("{file}:{line}: element {element} is distorted: {reason}")]
+    DistortedElement {
+        /// The file.
+        file: String,
+        /// 1-based line number.
+        line: usize,
+        /// The element's Gmsh tag.
+        element: u64,
+        /// What is wrong.
+        reason: String,
     },
     /// A node lies outside the plane z = 0.
     #[error("{file}:{line}: node {node} has z = {z:e}; only planar meshes in z = 0 are supported")]
@@ -150,7 +189,7 @@ pub enum GmshError {
         /// The undefined node tag.
         node: u64,
     },
-    /// A quadrilateral whose corners enclose (almost) no area.
+    /// An element whose corners enclose (almost) no area.
     #[error("{file}:{line}: element {element} is degenerate: its corners enclose area {area:e}")]
     DegenerateElement {
         /// The file.
@@ -162,7 +201,7 @@ pub enum GmshError {
         /// Signed area of the corner polygon.
         area: f64,
     },
-    /// The file as a whole is incomplete (a missing section, no quadrilaterals, ...).
+    /// The file as a whole is incomplete (a missing section, no surface elements, ...).
     #[error("{file}: {message}")]
     Structure {
         /// The file.
@@ -189,57 +228,80 @@ pub const MAX_MESH_FILE_BYTES: u64 = {
 /// Result of the mesh readers.
 pub type Result<T> = std::result::Result<T, GmshError>;
 
-/// The two quadratic quadrilaterals the solver supports.
+/// The quadratic surface elements the solver supports.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum QuadKind {
+pub enum SurfaceKind {
     /// 8-node serendipity quadrilateral (Gmsh type 16, VTK type 23).
     Q8,
     /// 9-node Lagrange quadrilateral (Gmsh type 10, VTK type 28).
     Q9,
+    /// 6-node triangle (Gmsh type 9, VTK type 22).
+    T6,
 }
 
-impl QuadKind {
+/// The former name of [`SurfaceKind`], from when only quadrilaterals were read.
+pub type QuadKind = SurfaceKind;
+
+impl SurfaceKind {
     /// Number of nodes of one element.
     pub const fn node_count(self) -> usize {
         match self {
-            QuadKind::Q8 => 8,
-            QuadKind::Q9 => 9,
+            SurfaceKind::Q8 => 8,
+            SurfaceKind::Q9 => 9,
+            SurfaceKind::T6 => 6,
         }
+    }
+
+    /// Number of corner nodes (they come first): 4 or 3.
+    pub const fn corner_count(self) -> usize {
+        match self {
+            SurfaceKind::Q8 | SurfaceKind::Q9 => 4,
+            SurfaceKind::T6 => 3,
+        }
+    }
+
+    /// True for the triangles.
+    pub const fn is_triangle(self) -> bool {
+        matches!(self, SurfaceKind::T6)
     }
 
     /// Gmsh element type number.
     pub const fn gmsh_type(self) -> u32 {
         match self {
-            QuadKind::Q8 => 16,
-            QuadKind::Q9 => 10,
+            SurfaceKind::Q8 => 16,
+            SurfaceKind::Q9 => 10,
+            SurfaceKind::T6 => 9,
         }
     }
 
-    /// VTK cell type number (`VTK_QUADRATIC_QUAD` = 23, `VTK_BIQUADRATIC_QUAD` = 28); VTK's
-    /// node order for these equals Gmsh's.
+    /// VTK cell type number (`VTK_QUADRATIC_QUAD` = 23, `VTK_BIQUADRATIC_QUAD` = 28,
+    /// `VTK_QUADRATIC_TRIANGLE` = 22); VTK's node order for these equals Gmsh's.
     pub const fn vtk_cell_type(self) -> u8 {
         match self {
-            QuadKind::Q8 => 23,
-            QuadKind::Q9 => 28,
+            SurfaceKind::Q8 => 23,
+            SurfaceKind::Q9 => 28,
+            SurfaceKind::T6 => 22,
         }
     }
 
-    fn from_gmsh_type(t: u32) -> Option<QuadKind> {
+    fn from_gmsh_type(t: u32) -> Option<SurfaceKind> {
         match t {
-            16 => Some(QuadKind::Q8),
-            10 => Some(QuadKind::Q9),
+            16 => Some(SurfaceKind::Q8),
+            10 => Some(SurfaceKind::Q9),
+            9 => Some(SurfaceKind::T6),
             _ => None,
         }
     }
 }
 
-/// One quadrilateral as read from the file.
+/// One surface element as read from the file.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RawElement {
-    /// 8- or 9-node.
-    pub kind: QuadKind,
-    /// 0-based node indices into [`RawMesh::nodes`], in Gmsh order: corners 0-3
-    /// counter-clockwise, mid-edge nodes 4 (0-1), 5 (1-2), 6 (2-3), 7 (3-0), centre 8 (Q9).
+    /// 8- or 9-node quadrilateral or 6-node triangle.
+    pub kind: SurfaceKind,
+    /// 0-based node indices into [`RawMesh::nodes`], in Gmsh order, counter-clockwise.
+    /// Quadrilaterals: corners 0-3, mid-edge nodes 4 (0-1), 5 (1-2), 6 (2-3), 7 (3-0), centre
+    /// 8 (Q9). Triangles: corners 0-2, mid-side nodes 3 (0-1), 4 (1-2), 5 (2-0).
     pub nodes: Vec<usize>,
     /// Names of every physical surface the element belongs to, in file order, each once
     /// (empty: none). An element may be in several.
@@ -251,7 +313,7 @@ pub struct RawElement {
 pub struct RawMesh {
     /// Node coordinates (x, y), indexed 0-based.
     pub nodes: Vec<[f64; 2]>,
-    /// The quadrilaterals, in increasing Gmsh element tag order.
+    /// The surface elements, in increasing Gmsh element tag order.
     pub elements: Vec<RawElement>,
     /// `$PhysicalNames`: (dimension, physical tag) -> name.
     pub physical_names: BTreeMap<(u32, i32), String>,

@@ -1,4 +1,5 @@
-//! The macro mesh: nodes, quadratic quadrilaterals and named node, edge and element sets.
+//! The macro mesh: nodes, quadratic elements (8- and 9-node quadrilaterals, 6-node
+//! triangles; one kind per mesh for now) and named node, edge and element sets.
 //!
 //! Every mesh, structured or read from a file, goes through [`Mesh::from_description`]: the
 //! Gmsh reader only has to fill a [`MeshDescription`].
@@ -9,7 +10,7 @@
 mod structured;
 pub use structured::MAX_ELEMENTS;
 
-use crate::element::ElementKind;
+use crate::element::{ElementKind, shape_defect};
 use crate::error::{Error, Result};
 use std::collections::{BTreeMap, HashMap};
 
@@ -19,8 +20,8 @@ use std::collections::{BTreeMap, HashMap};
 pub struct MeshDescription {
     /// Node coordinates `[x, y]` (m).
     pub nodes: Vec<[f64; 2]>,
-    /// Element node lists: 8 (Gmsh type 16) or 9 (type 10) nodes in Gmsh order; all elements
-    /// of one mesh have the same kind.
+    /// Element node lists: 8 (Gmsh type 16), 9 (type 10) or 6 (type 9, triangle) nodes in
+    /// Gmsh order; all elements of one mesh have the same kind.
     pub elements: Vec<Vec<usize>>,
     /// Named node groups (Gmsh physical points or any node list).
     pub node_groups: BTreeMap<String, Vec<usize>>,
@@ -65,14 +66,18 @@ fn invalid(field: &'static str, value: impl ToString, reason: impl ToString) -> 
     Error::InvalidMesh { field, value: value.to_string(), reason: reason.to_string() }
 }
 
-/// Node permutation that reverses the orientation of a quadratic quad (Gmsh order).
-const FLIP: [usize; 9] = [0, 3, 2, 1, 7, 6, 5, 4, 8];
-
 impl Mesh {
     /// Builds and checks a mesh from a raw description.
     ///
-    /// Elements given clockwise are renumbered counter-clockwise; edge groups are matched to
-    /// the element that owns them and oriented counter-clockwise around it. Element groups
+    /// The element kind follows from the first element's node count (8: Q8, 9: Q9, 6: T6);
+    /// every element must have as many. Elements given clockwise (signed area of the corner
+    /// polygon) are renumbered counter-clockwise with [`ElementKind::flip`]; an element of
+    /// zero area is an error naming it. Triangles are also held to [`shape_defect`]
+    /// (mid-side nodes within a quarter of the edge length of the edge's midpoint, positive
+    /// Jacobian at nodes and integration points), an error naming the element and the node;
+    /// quadrilaterals are checked at their Gauss points when the Gauss data are built. Edge
+    /// groups are matched to the element that owns them and oriented counter-clockwise
+    /// around it. Element groups
     /// become sorted, unique element sets; an index past the last element is an error naming
     /// the group.
     pub fn from_description(desc: MeshDescription) -> Result<Self> {
@@ -88,7 +93,14 @@ impl Mesh {
         let kind = match first.len() {
             8 => ElementKind::Q8,
             9 => ElementKind::Q9,
-            n => return Err(invalid("elements[0].len()", n, "expected 8 (Q8) or 9 (Q9) nodes")),
+            6 => ElementKind::T6,
+            n => {
+                return Err(invalid(
+                    "elements[0].len()",
+                    n,
+                    "expected 8 (Q8), 9 (Q9) or 6 (T6) nodes",
+                ));
+            }
         };
         for (i, p) in nodes.iter().enumerate() {
             if !(p[0].is_finite() && p[1].is_finite()) {
@@ -108,17 +120,25 @@ impl Mesh {
             if let Some(&bad) = el.iter().find(|&&n| n >= nodes.len()) {
                 return Err(invalid("elements", e, format!("node {bad} >= {}", nodes.len())));
             }
-            let c: Vec<[f64; 2]> = el[..4].iter().map(|&n| nodes[n]).collect();
-            let area2 = (0..4)
-                .map(|k| c[k][0] * c[(k + 1) % 4][1] - c[(k + 1) % 4][0] * c[k][1])
+            let nc = kind.corners();
+            let c: Vec<[f64; 2]> = el[..nc].iter().map(|&n| nodes[n]).collect();
+            let area2 = (0..nc)
+                .map(|k| c[k][0] * c[(k + 1) % nc][1] - c[(k + 1) % nc][0] * c[k][1])
                 .sum::<f64>();
             if area2 == 0.0 || !area2.is_finite() {
                 return Err(invalid("elements", e, "zero area"));
             }
+            let start = connectivity.len();
             if area2 > 0.0 {
                 connectivity.extend_from_slice(el);
             } else {
-                connectivity.extend(FLIP[..nn].iter().map(|&k| el[k]));
+                connectivity.extend(kind.flip().iter().map(|&k| el[k]));
+            }
+            if kind.is_triangle() {
+                let c: Vec<[f64; 2]> = connectivity[start..].iter().map(|&n| nodes[n]).collect();
+                if let Some(defect) = shape_defect(kind, &c) {
+                    return Err(invalid("elements", e, defect));
+                }
             }
         }
 
@@ -126,7 +146,7 @@ impl Mesh {
         let mut owner: HashMap<(usize, usize), (usize, usize)> = HashMap::new();
         for e in 0..elements.len() {
             let el = &connectivity[e * nn..(e + 1) * nn];
-            for (k, ed) in ElementKind::edges().iter().enumerate() {
+            for (k, ed) in kind.edges().iter().enumerate() {
                 let (a, b) = (el[ed[0]], el[ed[1]]);
                 owner.insert((a.min(b), a.max(b)), (e, k));
             }
@@ -150,7 +170,7 @@ impl Mesh {
                 let &(e, k) = owner.get(&(a.min(b), a.max(b))).ok_or_else(|| {
                     invalid("edge_groups", &name, format!("edge {line:?} is no element edge"))
                 })?;
-                let ed = ElementKind::edges()[k];
+                let ed = kind.edges()[k];
                 let el = &connectivity[e * nn..(e + 1) * nn];
                 let oriented = [el[ed[0]], el[ed[1]], el[ed[2]]];
                 if oriented[2] != line[2] {
@@ -235,7 +255,7 @@ impl Mesh {
 }
 
 impl From<crate::gmsh::RawMesh> for MeshDescription {
-    /// A Gmsh mesh as read by [`crate::gmsh`]: quadrilaterals, node groups, 3-node boundary
+    /// A Gmsh mesh as read by [`crate::gmsh`]: surface elements, node groups, 3-node boundary
     /// lines (edges of other lengths are not boundary edges of quadratic elements and are
     /// left to the node groups) and element groups from the physical surfaces (an element in
     /// two surfaces is in both groups; whether that is allowed is for the caller to decide).

@@ -1,4 +1,4 @@
-//! Structured rectangles of quadratic quadrilaterals.
+//! Structured rectangles of quadratic quadrilaterals or triangles.
 
 use super::{Mesh, MeshDescription};
 use crate::element::ElementKind;
@@ -14,8 +14,16 @@ impl Mesh {
     /// elements of `kind`.
     ///
     /// Named sets (nodes and edges): `bottom` (y = y0), `right`, `top`, `left`; node sets
-    /// `all` and the corners `bottom_left`, `bottom_right`, `top_left`, `top_right`. Nodes are numbered row by row from the bottom-left on the (2 nx + 1) x
-    /// (2 ny + 1) grid (Q8 skips element centres); elements row by row.
+    /// `all` and the corners `bottom_left`, `bottom_right`, `top_left`, `top_right`. Nodes
+    /// are numbered row by row from the bottom-left on the (2 nx + 1) x (2 ny + 1) grid (Q8
+    /// skips cell centres); cells row by row.
+    ///
+    /// Quadrilaterals: element `c` is cell `c`. 6-node triangles ([`ElementKind::T6`]): each
+    /// cell is split along its diagonal from bottom-left to top-right (all cells alike, the
+    /// cell centre being the diagonal's mid-side node): element `2c` is cell `c`'s lower-right
+    /// triangle (corners bottom-left, bottom-right, top-right), `2c + 1` its upper-left one
+    /// (bottom-left, top-right, top-left). So `nx * ny` cells give `2 nx ny` triangles, and the
+    /// sets are those of the quadrilateral meshes.
     pub fn rectangle(
         kind: ElementKind,
         lx: f64,
@@ -42,9 +50,11 @@ impl Mesh {
                 });
             }
         }
-        if nx.checked_mul(ny).is_none_or(|n| n > MAX_ELEMENTS) {
+        let per_cell = if kind.is_triangle() { 2 } else { 1 };
+        if nx.checked_mul(ny).and_then(|n| n.checked_mul(per_cell)).is_none_or(|n| n > MAX_ELEMENTS)
+        {
             return Err(Error::InvalidMesh {
-                field: "nx * ny",
+                field: if kind.is_triangle() { "2 * nx * ny" } else { "nx * ny" },
                 value: format!("{nx} * {ny}"),
                 reason: format!("more than MAX_ELEMENTS = {MAX_ELEMENTS} elements"),
             });
@@ -69,6 +79,13 @@ impl Mesh {
         for ey in 0..ny {
             for ex in 0..nx {
                 let (i, j) = (2 * ex, 2 * ey);
+                if kind.is_triangle() {
+                    let (bl, br, tr, tl) = (g(i, j), g(i + 2, j), g(i + 2, j + 2), g(i, j + 2));
+                    let centre = g(i + 1, j + 1);
+                    desc.elements.push(vec![bl, br, tr, g(i + 1, j), g(i + 2, j + 1), centre]);
+                    desc.elements.push(vec![bl, tr, tl, centre, g(i + 1, j + 2), g(i, j + 1)]);
+                    continue;
+                }
                 let mut el = vec![
                     g(i, j),
                     g(i + 2, j),
@@ -125,6 +142,43 @@ mod tests {
         let m9 = Mesh::rectangle(ElementKind::Q9, 1.0, 1.0, 2, 2, [0.0, 0.0]).unwrap();
         assert_eq!(m9.n_nodes(), 25);
         assert!(m.node_set("nope").unwrap_err().to_string().contains("top"));
+    }
+
+    /// The triangle rectangle: two triangles per cell, the full node grid, the quads' sets
+    /// (same node sets as Q9, edges owned by the triangle on that side, counter-clockwise),
+    /// and the elements' areas summing to the rectangle's (exact: binary fractions).
+    #[test]
+    fn triangle_rectangle_counts_and_sets() {
+        let m = Mesh::rectangle(ElementKind::T6, 2.0, 1.0, 4, 2, [0.0, 0.0]).unwrap();
+        let m9 = Mesh::rectangle(ElementKind::Q9, 2.0, 1.0, 4, 2, [0.0, 0.0]).unwrap();
+        assert_eq!(m.kind, ElementKind::T6);
+        assert_eq!(m.n_elements(), 16);
+        assert_eq!(m.n_nodes(), 9 * 5);
+        assert_eq!(m.nodes, m9.nodes);
+        assert_eq!(m.node_sets, m9.node_sets);
+        for side in ["bottom", "right", "top", "left"] {
+            let (t, q) = (m.edge_set(side).unwrap(), m9.edge_set(side).unwrap());
+            assert_eq!(t.len(), q.len());
+            for (a, b) in t.iter().zip(q) {
+                assert_eq!(a.nodes, b.nodes, "{side}");
+                // lower-right triangles (even) own bottom and right, upper-left the others
+                let upper = side == "top" || side == "left";
+                assert_eq!(a.element % 2 == 1, upper, "{side}");
+            }
+        }
+        let area: f64 = (0..m.n_elements())
+            .map(|e| {
+                let c = m.element_coords(e);
+                let a2 = (c[1][0] - c[0][0]) * (c[2][1] - c[0][1])
+                    - (c[2][0] - c[0][0]) * (c[1][1] - c[0][1]);
+                assert!(a2 > 0.0, "element {e} clockwise");
+                a2 / 2.0
+            })
+            .sum();
+        assert_eq!(area, 2.0);
+        // element 2c + 1 of cell c = 5 (ex = 1, ey = 1): corners (0.5,0.5), (1,1), (0.5,1)
+        let c = m.element_coords(11);
+        assert_eq!(&c[..3], &[[0.5, 0.5], [1.0, 1.0], [0.5, 1.0]]);
     }
 
     /// A described mesh (a Gmsh file) is held to the rectangle's cap too.

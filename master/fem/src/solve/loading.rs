@@ -323,14 +323,15 @@ mod tests {
 
     /// A pressure p on each side of a 2 x 1.5 rectangle adds up to p times the side length,
     /// pointing into the body; a traction likewise (exact: quadratic shape functions on
-    /// straight edges, 3-point rule).
+    /// straight edges, 3-point rule), for the quadrilaterals and the triangles alike (an
+    /// edge is the same 3-node line).
     #[test]
     fn edge_loads_add_up_to_their_resultants() {
-        for kind in [ElementKind::Q8, ElementKind::Q9] {
+        for kind in [ElementKind::Q8, ElementKind::Q9, ElementKind::T6] {
             let mesh = Mesh::rectangle(kind, 2.0, 1.5, 3, 2, [0.0, 0.0]).unwrap();
             let dofs =
                 DofMap::new(Field::Cosserat, mesh.n_nodes(), &vec![false; 3 * mesh.n_nodes()]);
-            let gauss = GaussData::new(&mesh, QuadratureRule::Gauss2x2).unwrap();
+            let gauss = GaussData::new(&mesh, QuadratureRule::for_kind(kind, false)).unwrap();
             for (side, expect) in [
                 ("right", [-3.0, 0.0]),
                 ("left", [3.0, 0.0]),

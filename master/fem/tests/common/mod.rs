@@ -13,16 +13,23 @@ use cosdem_fem::solve::{Dirichlet, Loading, SolutionView};
 pub const ELEMENTS: [(ElementKind, QuadratureRule); 2] =
     [(ElementKind::Q8, QuadratureRule::Gauss2x2), (ElementKind::Q9, QuadratureRule::Gauss3x3)];
 
-/// A unit square of 3x3 elements whose interior corner nodes are moved by up to 20 % of
-/// the element size (deterministically); edges stay straight: mid-edge nodes at edge
-/// midpoints, Q9 centres at the bilinear centre. So the isoparametric map is bilinear, and
-/// the rules integrate the constant-stress element forces exactly (what the patch test needs).
+/// The 6-node triangle with its reduced (3-point, degree 2) and full (6-point, degree 4)
+/// rules.
+pub const TRIANGLES: [(ElementKind, QuadratureRule); 2] =
+    [(ElementKind::T6, QuadratureRule::Triangle3), (ElementKind::T6, QuadratureRule::Triangle6)];
+
+/// A unit square of 3x3 elements (cells split in two for triangles) whose interior corner
+/// nodes are moved by up to 20 % of the element size (deterministically); edges stay
+/// straight: mid-edge nodes at edge midpoints, Q9 centres at the bilinear centre. So the
+/// isoparametric map is bilinear (affine for triangles), and the rules integrate the
+/// constant-stress element forces exactly (what the patch test needs). The triangles' grid
+/// vertices are moved as the quadrilaterals' are (same shifts in the same order).
 pub fn distorted_square(kind: ElementKind) -> Mesh {
     let mut m = Mesh::rectangle(kind, 1.0, 1.0, 3, 3, [0.0, 0.0]).unwrap();
     let shifts = [[0.06, -0.04], [-0.05, 0.065], [0.045, 0.05], [-0.06, -0.03]];
     let mut k = 0;
     let corners: std::collections::BTreeSet<usize> =
-        (0..m.n_elements()).flat_map(|e| m.element_nodes(e)[..4].to_vec()).collect();
+        (0..m.n_elements()).flat_map(|e| m.element_nodes(e)[..kind.corners()].to_vec()).collect();
     for &n in &corners {
         let [x, y] = m.nodes[n];
         let interior = x > 1e-9 && x < 1.0 - 1e-9 && y > 1e-9 && y < 1.0 - 1e-9;
@@ -33,9 +40,9 @@ pub fn distorted_square(kind: ElementKind) -> Mesh {
     }
     for e in 0..m.n_elements() {
         let el = m.element_nodes(e).to_vec();
-        let c: Vec<[f64; 2]> = el[..4].iter().map(|&n| m.nodes[n]).collect();
+        let c: Vec<[f64; 2]> = el[..kind.corners()].iter().map(|&n| m.nodes[n]).collect();
         let mid = |a: [f64; 2], b: [f64; 2]| [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0];
-        for (slot, (a, b)) in [(4, (0, 1)), (5, (1, 2)), (6, (2, 3)), (7, (3, 0))] {
+        for &[a, b, slot] in kind.edges() {
             m.nodes[el[slot]] = mid(c[a], c[b]);
         }
         if kind == ElementKind::Q9 {
@@ -102,12 +109,18 @@ pub fn fe_field(
     (s.x, [val, [s.det_j, 0.0, 0.0], [0.0; 3]], grad)
 }
 
-/// Integrates `f(x, fe value, fe gradient)` over the mesh with 4x4 Gauss points per element.
+/// Integrates `f(x, fe value, fe gradient)` over the mesh with 4x4 Gauss points per element
+/// (quadrilaterals) or their collapsed counterpart, exact to degree 6 (triangles).
 pub fn integrate(
     view: &SolutionView<'_>,
     f: impl Fn([f64; 2], [f64; 3], [[f64; 2]; 3]) -> f64,
 ) -> f64 {
-    let q = Quadrature::new(QuadratureRule::Gauss4x4);
+    let rule = if view.mesh.kind.is_triangle() {
+        QuadratureRule::Triangle16
+    } else {
+        QuadratureRule::Gauss4x4
+    };
+    let q = Quadrature::new(rule);
     let mut sum = 0.0;
     for e in 0..view.mesh.n_elements() {
         for (p, w) in q.points.iter().zip(&q.weights) {

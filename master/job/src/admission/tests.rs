@@ -135,3 +135,28 @@ fn sizes_print_in_binary_units() {
     assert_eq!(size(1.5 * 1024.0 * 1024.0), "1.5 MiB");
     assert_eq!(size(24.0 * GIB as f64), "24.0 GiB");
 }
+
+/// A structured T6 rectangle counts two triangles per cell, every node of the
+/// (2 nx + 1) x (2 ny + 1) grid (the diagonals' mid-sides are the cells' centres) and 3 Gauss
+/// points per triangle (`reduced`) or 6 (`full`); the counts from the keys equal the built
+/// mesh's (exact: integers), and the key `mesh.element = "t6"` is named with the points.
+#[test]
+fn a_t6_rectangle_counts_three_points_per_triangle() {
+    let hex = "packing = { kind = \"hexagonal\", radius = 0.005, side = 0.1 }";
+    let base = quick(2, hex);
+    let text = std::fs::read_to_string(fixtures::dir().join("../../examples/quick.toml"))
+        .unwrap()
+        .replace("element = \"q8\"", "element = \"t6\"");
+    let t6 = job(&text);
+    let counts = MeshCounts::of_job(&t6).unwrap();
+    assert_eq!(counts.kind, ElementKind::T6);
+    assert_eq!((counts.elements, counts.nodes, counts.nodes_per_element), (8.0, 25.0, 6.0));
+    assert_eq!(counts, MeshCounts::of_mesh(&t6.build_mesh().unwrap()));
+    let e = of(&t6);
+    assert_eq!(e.gauss_points, 24.0);
+    assert_eq!(of(&base).gauss_points, 16.0);
+    let dem = e.parts.iter().find(|p| p.name == "DEM assemblies").unwrap();
+    assert!(dem.keys.iter().any(|k| k == "mesh.element = \"t6\""), "{dem:?}");
+    let full = job(&text.replace("integration = \"reduced\"", "integration = \"full\""));
+    assert_eq!(of(&full).gauss_points, 48.0);
+}

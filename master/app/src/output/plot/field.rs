@@ -2,7 +2,7 @@ use super::{
     Draw, DrawResult, FONT, Figure, PlotError, Result, equal_aspect, sig4, viridis, write_figure,
 };
 use crate::output::field_data::FieldData;
-use cosdem_fem::element::{ElementKind, gauss_1d};
+use cosdem_fem::element::{ElementKind, Quadrature, QuadratureRule, gauss_1d};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
@@ -10,8 +10,14 @@ use std::path::Path;
 /// Sub-cells per element side when the field is painted.
 const SUBDIVISIONS: usize = 24;
 
+/// The element family of a node list: 6 nodes a T6, 9 a Q9, otherwise a Q8 (what
+/// [`FieldData::read`] lets through).
 fn kind_of(nodes: usize) -> ElementKind {
-    if nodes == 9 { ElementKind::Q9 } else { ElementKind::Q8 }
+    match nodes {
+        6 => ElementKind::T6,
+        9 => ElementKind::Q9,
+        _ => ElementKind::Q8,
+    }
 }
 
 /// Lagrange basis through the 1D Gauss points `g` at `t`.
@@ -21,29 +27,143 @@ fn lagrange(g: &[f64], t: f64) -> Vec<f64> {
         .collect()
 }
 
-/// Nodal values of the Gauss-point equivalent strain: in every element, the tensor-product
-/// Lagrange polynomial through its n x n Gauss values evaluated at the nodes (the usual
-/// extrapolation), then averaged over the elements sharing each node.
-pub fn nodal_values(f: &FieldData) -> Vec<f64> {
-    let n = (f.gauss_per_element as f64).sqrt().round() as usize;
+/// The complete polynomials of degree `degree` (1: `1, x, y`; 2: also `x^2, xy, y^2`) at `p`.
+fn monomials(degree: usize, p: [f64; 2]) -> Vec<f64> {
+    let [x, y] = p;
+    let mut m = vec![1.0, x, y];
+    if degree >= 2 {
+        m.extend([x * x, x * y, y * y]);
+    }
+    m
+}
+
+/// The inverse of the square matrix `a` (Gauss-Jordan with partial pivoting); `None` when it
+/// is singular.
+fn invert(mut a: Vec<Vec<f64>>) -> Option<Vec<Vec<f64>>> {
+    let n = a.len();
+    let mut inv: Vec<Vec<f64>> =
+        (0..n).map(|i| (0..n).map(|j| if i == j { 1.0 } else { 0.0 }).collect()).collect();
+    for c in 0..n {
+        let p = (c..n).max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs()))?;
+        if a[p][c].abs() < 1e-12 {
+            return None;
+        }
+        a.swap(c, p);
+        inv.swap(c, p);
+        let d = a[c][c];
+        a[c].iter_mut().chain(inv[c].iter_mut()).for_each(|v| *v /= d);
+        for r in (0..n).filter(|&r| r != c) {
+            let f = a[r][c];
+            for k in 0..n {
+                a[r][k] -= f * a[c][k];
+                inv[r][k] -= f * inv[c][k];
+            }
+        }
+    }
+    Some(inv)
+}
+
+/// The extrapolation from the `points` Gauss points of a `kind` element to its nodes:
+/// `m[a][g]` is node `a`'s weight of point `g`. On a quadrilateral, the tensor-product Lagrange
+/// polynomial through the n x n points; on a triangle, the complete polynomial through the
+/// rule's points (linear through 3, quadratic through 6: both rules are unisolvent), so that a
+/// mid-side node of a 3-point triangle gets the mean of its corners. `None` for a rule the
+/// solver does not have.
+fn extrapolation(kind: ElementKind, points: usize) -> Option<Vec<Vec<f64>>> {
+    let nodes = kind.reference_nodes();
+    if kind.is_triangle() {
+        let degree = match points {
+            3 => 1,
+            6 => 2,
+            _ => return None,
+        };
+        let rule = Quadrature::new(match points {
+            3 => QuadratureRule::Triangle3,
+            _ => QuadratureRule::Triangle6,
+        });
+        let v = invert(rule.points.iter().map(|&p| monomials(degree, p)).collect())?;
+        let m = nodes
+            .iter()
+            .map(|&xi| {
+                let at = monomials(degree, xi);
+                (0..points).map(|g| (0..points).map(|k| at[k] * v[k][g]).sum()).collect()
+            })
+            .collect();
+        return Some(m);
+    }
+    let n = (points as f64).sqrt().round() as usize;
+    if n * n != points || !(2..=4).contains(&n) {
+        return None;
+    }
     let (g, _) = gauss_1d(n);
+    let m = nodes
+        .iter()
+        .map(|xi| {
+            let (lx, ly) = (lagrange(&g, xi[0]), lagrange(&g, xi[1]));
+            (0..points).map(|p| lx[p % n] * ly[p / n]).collect()
+        })
+        .collect();
+    Some(m)
+}
+
+/// Nodal values of the Gauss-point equivalent strain: in every element, the polynomial through
+/// its Gauss values evaluated at the nodes ([`extrapolation`]: the usual extrapolation), then
+/// averaged over the elements sharing each node.
+pub fn nodal_values(f: &FieldData) -> Vec<f64> {
+    let per = f.gauss_per_element;
     let mut sum = vec![0.0; f.nodes.len()];
     let mut count = vec![0u32; f.nodes.len()];
+    let mut matrices = std::collections::BTreeMap::new();
     for (e, nodes) in f.elements.iter().enumerate() {
-        let q = &f.equivalent_strain[e * f.gauss_per_element..(e + 1) * f.gauss_per_element];
-        for (a, xi) in kind_of(nodes.len()).reference_nodes().iter().enumerate() {
-            let (lx, ly) = (lagrange(&g, xi[0]), lagrange(&g, xi[1]));
-            let mut v = 0.0;
-            for j in 0..n {
-                for i in 0..n {
-                    v += lx[i] * ly[j] * q[j * n + i];
-                }
-            }
-            sum[nodes[a]] += v;
+        let q = &f.equivalent_strain[e * per..(e + 1) * per];
+        let m =
+            matrices.entry(nodes.len()).or_insert_with(|| extrapolation(kind_of(nodes.len()), per));
+        let Some(m) = m else { continue };
+        for (a, row) in m.iter().enumerate() {
+            sum[nodes[a]] += row.iter().zip(q).map(|(w, v)| w * v).sum::<f64>();
             count[nodes[a]] += 1;
         }
     }
     sum.iter().zip(&count).map(|(s, &c)| if c > 0 { s / f64::from(c) } else { 0.0 }).collect()
+}
+
+/// The sub-cells an element is painted with, in reference coordinates: `k x k` quadrilaterals
+/// of the reference square, or the `k^2` triangles of the reference triangle cut `k` times
+/// along each side (`k (k + 1) / 2` upright, `k (k - 1) / 2` upside down).
+fn sub_cells(kind: ElementKind, k: usize) -> Vec<Vec<[f64; 2]>> {
+    let c = &kind.reference_nodes()[..kind.corners()];
+    let s = |i: usize| i as f64 / k as f64;
+    let mut cells = Vec::with_capacity(k * k);
+    if kind.is_triangle() {
+        let at = |i: usize, j: usize| {
+            let (a, b) = (s(i), s(j));
+            [0, 1].map(|d| c[0][d] + a * (c[1][d] - c[0][d]) + b * (c[2][d] - c[0][d]))
+        };
+        for j in 0..k {
+            for i in 0..k - j {
+                cells.push(vec![at(i, j), at(i + 1, j), at(i, j + 1)]);
+                if i + j + 1 < k {
+                    cells.push(vec![at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]);
+                }
+            }
+        }
+    } else {
+        let at = |i: usize, j: usize| {
+            let (a, b) = (s(i), s(j));
+            [0, 1].map(|d| {
+                (1.0 - a) * (1.0 - b) * c[0][d]
+                    + a * (1.0 - b) * c[1][d]
+                    + a * b * c[2][d]
+                    + (1.0 - a) * b * c[3][d]
+            })
+        };
+        for j in 0..k {
+            for i in 0..k {
+                cells.push(vec![at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)]);
+            }
+        }
+    }
+    cells
 }
 
 /// Shape-function interpolation of nodal `values` and deformed positions in element `e`.
@@ -144,41 +264,39 @@ fn draw_mesh<DB: DrawingBackend>(
         .axis_desc_style((FONT, 19))
         .draw()
         .at(path)?;
-    let k = SUBDIVISIONS;
-    let t = |i: usize| -1.0 + 2.0 * i as f64 / k as f64;
-    for e in 0..f.elements.len() {
-        let mut cells = Vec::with_capacity(k * k);
-        for j in 0..k {
-            for i in 0..k {
-                let corner = |a: usize, b: usize| {
-                    let (p, _) = interpolate(f, e, values, [t(i + a), t(j + b)]);
-                    (p[0], p[1])
-                };
-                let centre = [0.5 * (t(i) + t(i + 1)), 0.5 * (t(j) + t(j + 1))];
-                let (_, v) = interpolate(f, e, values, centre);
-                let colour = viridis((v - lo) / (hi - lo));
-                cells.push(Polygon::new(
-                    vec![corner(0, 0), corner(1, 0), corner(1, 1), corner(0, 1)],
-                    colour.filled(),
-                ));
+    for (e, nodes) in f.elements.iter().enumerate() {
+        let cells = sub_cells(kind_of(nodes.len()), SUBDIVISIONS).into_iter().map(|cell| {
+            let mut centre = [0.0; 2];
+            for p in &cell {
+                centre = [centre[0] + p[0], centre[1] + p[1]];
             }
-        }
+            let centre = centre.map(|c| c / cell.len() as f64);
+            let (_, v) = interpolate(f, e, values, centre);
+            let colour = viridis((v - lo) / (hi - lo));
+            let corners = cell
+                .iter()
+                .map(|&xi| {
+                    let (p, _) = interpolate(f, e, values, xi);
+                    (p[0], p[1])
+                })
+                .collect::<Vec<_>>();
+            Polygon::new(corners, colour.filled())
+        });
         chart.draw_series(cells).at(path)?;
     }
     // Element edges, deformed (black) and the undeformed outline (grey).
-    let m = 8 * k;
+    let m = 8 * SUBDIVISIONS;
     for (e, nodes) in f.elements.iter().enumerate() {
         let kind = kind_of(nodes.len());
-        let mut deformed = Vec::with_capacity(4 * m + 1);
-        let mut reference = Vec::with_capacity(4 * m + 1);
-        let corners = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0], [-1.0, -1.0]];
-        for s in 0..4 {
-            for i in 0..=m {
+        let corners = &kind.reference_nodes()[..kind.corners()];
+        let mut deformed = Vec::with_capacity(corners.len() * m + 1);
+        let mut reference = Vec::with_capacity(corners.len() * m + 1);
+        for (s, from) in corners.iter().enumerate() {
+            let to = corners[(s + 1) % corners.len()];
+            let last = if s + 1 == corners.len() { m } else { m - 1 };
+            for i in 0..=last {
                 let a = i as f64 / m as f64;
-                let xi = [
-                    corners[s][0] + a * (corners[s + 1][0] - corners[s][0]),
-                    corners[s][1] + a * (corners[s + 1][1] - corners[s][1]),
-                ];
+                let xi = [from[0] + a * (to[0] - from[0]), from[1] + a * (to[1] - from[1])];
                 let (p, _) = interpolate(f, e, values, xi);
                 deformed.push((p[0], p[1]));
                 let mut n = [0.0; 9];
@@ -240,64 +358,106 @@ fn draw_colour_bar<DB: DrawingBackend>(
 mod tests {
     use super::*;
     use crate::output::plot::SIZE;
+    use cosdem_fem::assembly::GaussData;
 
-    fn sample(q: impl Fn([f64; 2]) -> f64) -> FieldData {
-        let mesh =
-            cosdem_fem::mesh::Mesh::rectangle(ElementKind::Q8, 1.0, 1.0, 2, 2, [0.0, 0.0]).unwrap();
-        let (g, _) = gauss_1d(2);
-        let mut strain = Vec::new();
-        for e in 0..mesh.n_elements() {
-            let c = mesh.element_coords(e);
-            for j in 0..2 {
-                for i in 0..2 {
-                    let mut n = [0.0; 8];
-                    let mut dn = [[0.0; 2]; 8];
-                    ElementKind::Q8.shape([g[i], g[j]], &mut n, &mut dn);
-                    let x = [0usize, 1].map(|k| (0..8).map(|a| n[a] * c[a][k]).sum::<f64>());
-                    strain.push(q(x));
-                }
-            }
-        }
+    /// The unit square meshed 2 x 2 with `kind`, its Gauss points of `rule` holding `q(x)`.
+    fn sample(kind: ElementKind, rule: QuadratureRule, q: impl Fn([f64; 2]) -> f64) -> FieldData {
+        let mesh = cosdem_fem::mesh::Mesh::rectangle(kind, 1.0, 1.0, 2, 2, [0.0, 0.0]).unwrap();
+        let gauss = GaussData::new(&mesh, rule).unwrap();
         FieldData {
             step: 3,
             displacement: 0.006,
             internal_length: 0.01,
             displacements: mesh.nodes.iter().map(|p| [0.0, -0.01 * p[1]]).collect(),
             nodes: mesh.nodes.clone(),
-            elements: mesh.connectivity.chunks(8).map(|c| c.to_vec()).collect(),
-            gauss_per_element: 4,
-            equivalent_strain: strain,
+            elements: mesh.connectivity.chunks(kind.nodes()).map(|c| c.to_vec()).collect(),
+            gauss_per_element: gauss.per_element,
+            equivalent_strain: gauss.x.iter().map(|&x| q(x)).collect(),
         }
+    }
+
+    /// The largest nodal error of `f`'s extrapolation against the exact `q`.
+    fn nodal_error(f: &FieldData, q: impl Fn([f64; 2]) -> f64) -> f64 {
+        nodal_values(f).iter().zip(&f.nodes).map(|(v, &p)| (v - q(p)).abs()).fold(0.0, f64::max)
     }
 
     /// A field linear in x and y is reproduced exactly at the nodes (the extrapolation is exact
     /// for bilinear data, and the averages of equal values are equal).
     #[test]
     fn extrapolation_is_exact_for_bilinear_fields() {
-        let f = sample(|x| 0.01 + 0.02 * x[0] - 0.005 * x[1]);
-        for (v, p) in nodal_values(&f).iter().zip(&f.nodes) {
-            assert!((v - (0.01 + 0.02 * p[0] - 0.005 * p[1])).abs() < 1e-14, "{p:?}: {v}");
+        let q = |x: [f64; 2]| 0.01 + 0.02 * x[0] - 0.005 * x[1];
+        let f = sample(ElementKind::Q8, QuadratureRule::Gauss2x2, q);
+        assert!(nodal_error(&f, q) < 1e-14, "{}", nodal_error(&f, q));
+    }
+
+    /// On triangles the extrapolation is the linear polynomial through the 3 points (so a
+    /// mid-side node gets the mean of its corners) and the quadratic one through the 6 points:
+    /// a linear field comes back at every node from either rule, a quadratic one from the
+    /// 6 points. Tolerance 1e-13: the rules' points are given to 16 digits and the 6 x 6
+    /// Vandermonde system of the quadratic fit loses about two more to its conditioning.
+    #[test]
+    fn triangle_extrapolation_is_exact_for_its_polynomials() {
+        fn linear(x: [f64; 2]) -> f64 {
+            0.01 + 0.02 * x[0] - 0.005 * x[1]
+        }
+        fn quadratic(x: [f64; 2]) -> f64 {
+            linear(x) + 0.03 * x[0] * x[1] - 0.01 * x[1] * x[1]
+        }
+        let f = sample(ElementKind::T6, QuadratureRule::Triangle3, linear);
+        assert_eq!((f.gauss_per_element, f.elements.len()), (3, 8));
+        assert!(nodal_error(&f, linear) < 1e-13, "{}", nodal_error(&f, linear));
+        let m = extrapolation(ElementKind::T6, 3).unwrap();
+        for (mid, [a, b]) in [(3, [0, 1]), (4, [1, 2]), (5, [2, 0])] {
+            for g in 0..3 {
+                assert!((m[mid][g] - 0.5 * (m[a][g] + m[b][g])).abs() < 1e-14, "node {mid}");
+            }
+        }
+        for q in [linear as fn([f64; 2]) -> f64, quadratic] {
+            let f = sample(ElementKind::T6, QuadratureRule::Triangle6, q);
+            assert_eq!(f.gauss_per_element, 6);
+            assert!(nodal_error(&f, q) < 1e-13, "{}", nodal_error(&f, q));
         }
     }
 
+    /// The reference triangle is cut into k^2 sub-triangles that tile it: their areas sum to
+    /// the triangle's 1/2 (1e-12: sums of 576 small areas).
+    #[test]
+    fn triangle_sub_cells_tile_the_reference_triangle() {
+        let cells = sub_cells(ElementKind::T6, SUBDIVISIONS);
+        assert_eq!(cells.len(), SUBDIVISIONS * SUBDIVISIONS);
+        let area: f64 = cells
+            .iter()
+            .map(|c| {
+                let (a, b, d) = (c[0], c[1], c[2]);
+                0.5 * ((b[0] - a[0]) * (d[1] - a[1]) - (d[0] - a[0]) * (b[1] - a[1]))
+            })
+            .inspect(|&a| assert!(a > 0.0, "a sub-triangle is inverted or flat"))
+            .sum();
+        assert!((area - 0.5).abs() < 1e-12, "{area}");
+    }
+
+    /// The figure is drawn with the peak colour and every element's sub-cells (4 Q8 elements
+    /// of 24 x 24 cells, or 8 triangles of 24^2 sub-triangles) and the colour bar.
     #[test]
     fn field_plot_is_drawn() {
         let dir = std::env::temp_dir().join(format!("cosdem-plot-field-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
-        let path = dir.join("field.png");
-        let f = sample(|x| (-((x[0] - 0.5).powi(2) + (x[1] - 0.5).powi(2)) * 8.0).exp() * 0.02);
-        plot_strain_field(&f, "test", &path).unwrap();
-        let img = image::open(&path).unwrap().to_rgb8();
-        assert_eq!(img.dimensions(), SIZE);
-        // The top of the colour map (the peak in the middle) and the bottom are both painted.
-        let has = |c: RGBColor| img.pixels().any(|p| p.0 == [c.0, c.1, c.2]);
-        assert!(has(viridis(1.0 - 0.5 / 256.0)), "no peak colour");
-        let ink = img.pixels().filter(|p| p.0 != [255, 255, 255]).count();
-        assert!(ink > 100_000, "{ink}");
-        let svg = crate::output::plot::svg_check::read_beside(&path);
-        // 4 elements of 24 x 24 painted cells, and the 256 bands of the colour bar.
-        assert!(svg.matches("<polygon").count() >= 4 * 24 * 24, "too few cells");
-        assert!(svg.matches("<rect").count() >= 256, "no colour bar");
+        let q = |x: [f64; 2]| (-((x[0] - 0.5).powi(2) + (x[1] - 0.5).powi(2)) * 8.0).exp() * 0.02;
+        for (kind, elements) in [(ElementKind::Q8, 4), (ElementKind::T6, 8)] {
+            let path = dir.join(format!("field-{kind:?}.png"));
+            let f = sample(kind, QuadratureRule::for_kind(kind, false), q);
+            plot_strain_field(&f, "test", &path).unwrap();
+            let img = image::open(&path).unwrap().to_rgb8();
+            assert_eq!(img.dimensions(), SIZE);
+            // The top of the colour map (the peak in the middle) and the bottom are both painted.
+            let has = |c: RGBColor| img.pixels().any(|p| p.0 == [c.0, c.1, c.2]);
+            assert!(has(viridis(1.0 - 0.5 / 256.0)), "{kind:?}: no peak colour");
+            let ink = img.pixels().filter(|p| p.0 != [255, 255, 255]).count();
+            assert!(ink > 100_000, "{kind:?}: {ink}");
+            let svg = crate::output::plot::svg_check::read_beside(&path);
+            assert!(svg.matches("<polygon").count() >= elements * 24 * 24, "too few cells");
+            assert!(svg.matches("<rect").count() >= 256, "no colour bar");
+        }
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }
