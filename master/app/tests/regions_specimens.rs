@@ -12,7 +12,7 @@
 //!   reports its specimens in the summary, and gives the same `curve.csv` bytes on one
 //!   and on two in-process workers (determinism whatever the number of workers).
 
-use cosdem_app::run::material::{plan_specimens, specimen_spec};
+use cosdem_app::run::material::plan_specimens;
 use cosdem_app::run::{Ending, Run};
 use cosdem_common::GaussPointId;
 use cosdem_job::{Job, MaterialSection};
@@ -94,7 +94,8 @@ fn by_default_one_specimen_is_the_material_itself() {
     let groups = plan_specimens(&job, &em, &ids(), None);
     assert_eq!(groups.len(), 1);
     assert_eq!(groups[0].ids, ids());
-    let spec = specimen_spec(&job, assembly(&job), &groups[0]);
+    let spec =
+        job.specimens.assembly_of(assembly(&job), groups[0].specimen, groups[0].confining_stress);
     assert_eq!(&spec, assembly(&job));
     assert_eq!(serde_json::to_vec(&spec).unwrap(), serde_json::to_vec(assembly(&job)).unwrap());
 }
@@ -113,7 +114,7 @@ fn seeded_specimens_cover_every_point_once() {
     assert_eq!(all, ids());
     for g in &groups {
         let cosdem_dem::PackingSpec::Random { seed, .. } =
-            specimen_spec(&job3, assembly(&job3), g).packing
+            job3.specimens.assembly_of(assembly(&job3), g.specimen, g.confining_stress).packing
         else {
             panic!("random")
         };

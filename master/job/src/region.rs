@@ -243,7 +243,7 @@ impl Job {
     /// `bulk_density` or is DEM (weighed from its assembly), and `[material]` is DEM or every
     /// region gives one (then the regions must cover the mesh: checked when the stages are
     /// built, where the elements are known).
-    pub(crate) fn regions_weigh_themselves(&self) -> bool {
+    pub(crate) fn weighs_without_stage_density(&self) -> bool {
         let dem = |m: &MaterialSection| matches!(m, MaterialSection::Dem { .. });
         let regions = self.region.iter().all(|r| r.bulk_density.is_some() || dem(&r.material));
         let all_given =

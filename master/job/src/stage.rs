@@ -568,7 +568,7 @@ impl Job {
                             "a body force needs the material's bulk density (kg/m^3, finite and > 0)",
                         ));
                     }
-                    None if g.ramp != StageRamp::Remove && !self.regions_weigh_themselves() => {
+                    None if g.ramp != StageRamp::Remove && !self.weighs_without_stage_density() => {
                         return Err(bad(
                             key(i, ".gravity.density"),
                             "missing",

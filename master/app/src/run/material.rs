@@ -14,7 +14,6 @@
 use super::{RunError, WorkerChoice};
 use cosdem_common::GaussPointId;
 use cosdem_common::micro::{AssemblyRequest, AssemblyState, BoundaryKind};
-use cosdem_dem::AssemblySpec;
 use cosdem_fem::material::{Material, Regions};
 use cosdem_fem::mesh::Mesh;
 use cosdem_job::{Consolidation, Job, MaterialSection};
@@ -97,13 +96,6 @@ pub fn plan_specimens(
         groups[g].ids.push(id);
     }
     groups
-}
-
-/// The spec of one group's specimen: the material's, with the seed moved by the specimen
-/// number and the confining stress of its level ([`cosdem_job::SpecimensSection::assembly_of`];
-/// a spec that neither changes is the material's bit for bit).
-pub fn specimen_spec(job: &Job, assembly: &AssemblySpec, group: &SpecimenGroup) -> AssemblySpec {
-    job.specimens.assembly_of(assembly, group.specimen, group.confining_stress)
 }
 
 /// What answers at the Gauss points `ids` (element-major) of `mesh`, and how many workers
@@ -194,7 +186,7 @@ fn dem_pool(
         let MaterialSection::Dem { assembly } = materials[g.material] else {
             unreachable!("plan_specimens groups DEM points only")
         };
-        let spec = specimen_spec(job, assembly, g);
+        let spec = job.specimens.assembly_of(assembly, g.specimen, g.confining_stress);
         // The disc count from the spec, so that a worker checks its limits before building
         // and the pool splits and times its requests by it.
         let request = AssemblyRequest {
