@@ -45,6 +45,8 @@ const EXAMPLES: &[(&str, u64)] = &[
     // 0.2 s for step 1 (4 points x 105 discs); to step 25, past the first steps that
     // need more than one Newton iteration (23-25).
     ("scene-a-post-peak", 25),
+    // The same under the updated-Lagrangian option (issue 29): 25 steps as well.
+    ("scene-a-post-peak-ul", 25),
     // 1.7 s for step 1 (400 points x 105 discs), the next four cheaper.
     ("panel-5m", 5),
     // Staged jobs (issue 28), K = 2 each. 6.4 s for steps 1-2 (112 points x 147 discs, surcharge
@@ -170,6 +172,11 @@ fn rve_size() {
 #[test]
 fn scene_a_post_peak() {
     check_prefix("scene-a-post-peak");
+}
+
+#[test]
+fn scene_a_post_peak_ul() {
+    check_prefix("scene-a-post-peak-ul");
 }
 
 #[test]

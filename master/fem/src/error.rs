@@ -83,8 +83,8 @@ pub enum Error {
     /// The load increment was cut below the minimum and the step still fails.
     #[error(
         "load step {step} failed from load factor {load_factor:.6e} with increment \
-         {increment:.3e}, and halving it would go below the minimum {min_increment:.3e}: \
-         {reason}{}",
+         {increment:.3e} (largest prescribed displacement of the attempt {displacement:.6e} m), \
+         and halving it would go below the minimum {min_increment:.3e}: {reason}{}",
         describe_points(gauss_points)
     )]
     StepTooSmall {
@@ -92,6 +92,9 @@ pub enum Error {
         step: u64,
         /// Last converged load factor.
         load_factor: f64,
+        /// The largest magnitude of a prescribed dof value in the last failed attempt (the
+        /// platen displacement of a compression; m, or rad for a prescribed rotation).
+        displacement: f64,
         /// Increment of the last failed attempt.
         increment: f64,
         /// The minimum increment allowed.

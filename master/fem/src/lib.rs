@@ -23,7 +23,7 @@
 //!     ],
 //!     ..Default::default()
 //! };
-//! let model = Model { mesh, field: Field::Cosserat, rule: QuadratureRule::Gauss2x2, loading };
+//! let model = Model { mesh, field: Field::Cosserat, rule: QuadratureRule::Gauss2x2, loading, kinematics: Default::default() };
 //! let mut solver = Solver::new(model, SolverSettings { steps: 5, ..Default::default() })?;
 //! let mut material = ElasticCosserat::new(1e7, 0.3, 5e6, 0.01);
 //! let mut curve: Vec<StepReport> = Vec::new(); // any StepObserver

@@ -72,7 +72,8 @@ fn run(
         body: Some(BodyLoad::new(move |_, x| body(mat, x))),
         ..Default::default()
     };
-    let model = Model { mesh, field: Field::Cosserat, rule, loading };
+    let model =
+        Model { mesh, field: Field::Cosserat, rule, loading, kinematics: Default::default() };
     let mut solver = Solver::new(model, SolverSettings { steps: 1, ..Default::default() }).unwrap();
     solver.run(&mut mat.clone(), &mut ()).unwrap();
     let view = solver.solution();

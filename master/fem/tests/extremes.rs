@@ -21,7 +21,13 @@ fn mesh() -> Mesh {
 /// Rough platens, top moved down by 0.01 m (strain 1e-2).
 fn compression() -> Model {
     let loading = Loading::compression(-0.01, 0.0, Platens::Rough);
-    Model { mesh: mesh(), field: Field::Cosserat, rule: QuadratureRule::Gauss2x2, loading }
+    Model {
+        mesh: mesh(),
+        field: Field::Cosserat,
+        rule: QuadratureRule::Gauss2x2,
+        loading,
+        kinematics: Default::default(),
+    }
 }
 
 /// Bottom clamped (u = 0), top sheared by u_x = 0.01 m with u_y = 0; w free everywhere, so
@@ -36,7 +42,13 @@ fn shear() -> Model {
     ] {
         loading.dirichlet.push(Dirichlet::new(set, c, v));
     }
-    Model { mesh: mesh(), field: Field::Cosserat, rule: QuadratureRule::Gauss2x2, loading }
+    Model {
+        mesh: mesh(),
+        field: Field::Cosserat,
+        rule: QuadratureRule::Gauss2x2,
+        loading,
+        kinematics: Default::default(),
+    }
 }
 
 /// Runs `model` with lc in one load step: the top reaction (Fx, Fy, M) or the error.

@@ -126,7 +126,13 @@ fn smooth_platens_give_the_uniaxial_plane_strain_answer() {
 fn scene_b_softening_panel_runs_to_the_end() {
     let mesh = Mesh::rectangle(ElementKind::Q8, 5.0, 5.0, 10, 10, [0.0, 0.0]).unwrap();
     let loading = Loading::compression(-0.18, 0.0, Platens::Rough);
-    let model = Model { mesh, field: Field::Cosserat, rule: QuadratureRule::Gauss2x2, loading };
+    let model = Model {
+        mesh,
+        field: Field::Cosserat,
+        rule: QuadratureRule::Gauss2x2,
+        loading,
+        kinematics: Default::default(),
+    };
     let mut solver =
         Solver::new(model, SolverSettings { steps: 18, ..Default::default() }).unwrap();
     assert_eq!(solver.gauss().len(), 400);

@@ -22,7 +22,7 @@ fn patch(field: Field, material: ElasticCosserat, exact: fn([f64; 2]) -> [f64; 3
     for (kind, rule) in ELEMENTS.into_iter().chain(TRIANGLES) {
         let mesh = distorted_square(kind);
         let loading = boundary_values(&mesh, field, exact);
-        let model = Model { mesh, field, rule, loading };
+        let model = Model { mesh, field, rule, loading, kinematics: Default::default() };
         let settings = SolverSettings { steps: 1, ..Default::default() };
         let mut solver = Solver::new(model, settings).unwrap();
         let mut mat = material;

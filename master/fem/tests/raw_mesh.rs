@@ -32,8 +32,13 @@ fn loading() -> Loading {
 }
 
 fn solve(mesh: Mesh) -> Solver {
-    let model =
-        Model { mesh, field: Field::Cosserat, rule: QuadratureRule::Gauss2x2, loading: loading() };
+    let model = Model {
+        mesh,
+        field: Field::Cosserat,
+        rule: QuadratureRule::Gauss2x2,
+        loading: loading(),
+        kinematics: Default::default(),
+    };
     let mut s = Solver::new(model, SolverSettings { steps: 2, ..Default::default() }).unwrap();
     s.run(&mut ElasticCosserat::new(1e7, 0.3, 5e6, 0.05), &mut ()).unwrap();
     s

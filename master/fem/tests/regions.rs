@@ -262,7 +262,8 @@ fn two_material_bar_stretches_as_springs_in_series() {
             }],
             ..Default::default()
         };
-        let model = Model { mesh, field: Field::Cosserat, rule, loading };
+        let model =
+            Model { mesh, field: Field::Cosserat, rule, loading, kinematics: Default::default() };
         let settings = SolverSettings { steps: 1, ..Default::default() };
         let mut solver = Solver::new(model, settings).unwrap();
         solver.run(&mut regions, &mut ()).unwrap();

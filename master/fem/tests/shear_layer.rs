@@ -82,7 +82,13 @@ fn strip(field: Field, layer: &Layer, ny: usize, profile: bool) -> Solver {
             }
         }
     }
-    let model = Model { mesh, field, rule: QuadratureRule::Gauss2x2, loading };
+    let model = Model {
+        mesh,
+        field,
+        rule: QuadratureRule::Gauss2x2,
+        loading,
+        kinematics: Default::default(),
+    };
     let mut s = Solver::new(model, SolverSettings { steps: 1, ..Default::default() }).unwrap();
     let mut mat = ElasticCosserat::new(layer.g, 0.3, layer.gc, layer.lc);
     s.run(&mut mat, &mut ()).unwrap();

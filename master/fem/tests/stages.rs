@@ -157,7 +157,13 @@ fn self_weight_settles_a_column_as_the_closed_form() {
         body_ramp: Ramp::Linear,
         ..Default::default()
     };
-    let model = Model { mesh, field: Field::Cosserat, rule: QuadratureRule::Gauss2x2, loading };
+    let model = Model {
+        mesh,
+        field: Field::Cosserat,
+        rule: QuadratureRule::Gauss2x2,
+        loading,
+        kinematics: Default::default(),
+    };
     let mut solver = Solver::new(model, settings(1)).unwrap();
     let mat = elastic();
     solver.run(&mut mat.clone(), &mut ()).unwrap();

@@ -215,7 +215,13 @@ fn a_rule_of_the_other_family_is_refused() {
         [(ElementKind::T6, QuadratureRule::Gauss2x2), (ElementKind::Q8, QuadratureRule::Triangle3)]
     {
         let mesh = Mesh::rectangle(kind, 1.0, 1.0, 2, 2, [0.0, 0.0]).unwrap();
-        let model = Model { mesh, field: Field::Cosserat, rule, loading: Loading::default() };
+        let model = Model {
+            mesh,
+            field: Field::Cosserat,
+            rule,
+            loading: Loading::default(),
+            kinematics: Default::default(),
+        };
         let msg = match Solver::new(model, SolverSettings::default()) {
             Ok(_) => panic!("{kind:?} with {rule:?} accepted"),
             Err(e) => e.to_string(),

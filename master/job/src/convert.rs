@@ -180,7 +180,13 @@ impl Job {
             false => self.loading(),
         };
         let rule = self.rule(mesh.kind);
-        Ok(cosdem_fem::solve::Model { mesh, field: self.field(), rule, loading })
+        Ok(cosdem_fem::solve::Model {
+            mesh,
+            field: self.field(),
+            rule,
+            loading,
+            kinematics: self.mesh.kinematics,
+        })
     }
 
     /// Newton and step settings.

@@ -1,6 +1,7 @@
 //! The tables of the job file as serde structs: every key, its meaning and its default.
 //! Unknown keys are refused (`deny_unknown_fields`); ranges are checked by [`Job::validate`].
 
+use cosdem_fem::assembly::Kinematics;
 use cosdem_fem::solve::SolverSettings;
 use cosdem_fem::symmetry::Symmetry;
 use serde::{Deserialize, Serialize};
@@ -122,6 +123,16 @@ pub struct MeshSection {
     /// of a symmetric rectangle (see [`cosdem_fem::symmetry`]).
     #[serde(default)]
     pub symmetry: Symmetry,
+    /// `small` (default: the paper's small-strain statement) or `updated_lagrangian`
+    /// (balance on the deformed configuration, geometric stiffness, follower pressures, an
+    /// objective elastic law). Not written when `small`, so jobs without it keep their
+    /// digests.
+    #[serde(default, skip_serializing_if = "is_small")]
+    pub kinematics: Kinematics,
+}
+
+fn is_small(k: &Kinematics) -> bool {
+    *k == Kinematics::Small
 }
 
 fn default_element() -> ElementChoice {

@@ -3,6 +3,8 @@
 //! that `1e308` reads `1e308` and not as 309 digits.
 
 use crate::schema::{ElementChoice, Job, MaterialSection, MeshKind, Moving};
+use cosdem_dem::spec::TangentFrame;
+use cosdem_fem::assembly::Kinematics;
 use cosdem_fem::error::{Error, Result};
 use cosdem_fem::mesh::MAX_ELEMENTS;
 use cosdem_fem::solve::{MAX_LOAD_STEPS, MIN_INCREMENT_FRACTION};
@@ -82,6 +84,28 @@ fn assembly_error(prefix: &str, e: cosdem_dem::Error) -> Error {
 }
 
 impl Job {
+    /// `[material.assembly] frame` is set by `[mesh] kinematics` (`current` under the
+    /// updated-Lagrangian option); `current` with small strain is refused: its tangent is
+    /// convected, which the small-strain assembly does not expect.
+    fn validate_frame(&self) -> Result<()> {
+        if self.mesh.kinematics == Kinematics::UpdatedLagrangian {
+            return Ok(());
+        }
+        for (i, m) in self.materials().into_iter().enumerate() {
+            if let MaterialSection::Dem { assembly } = m
+                && assembly.frame == TangentFrame::Current
+            {
+                let prefix = if i == 0 { String::new() } else { format!("region[{}].", i - 1) };
+                return Err(bad(
+                    interned(format!("{prefix}material.assembly.frame")),
+                    "current",
+                    "needs [mesh] kinematics = \"updated_lagrangian\" (which sets it)",
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// Checks every value that serde cannot: ranges and combinations.
     pub fn validate(&self) -> Result<()> {
         self.validate_mesh()?;
@@ -94,6 +118,7 @@ impl Job {
             check_material(&r.material, &prefix)?;
         }
         self.validate_specimens()?;
+        self.validate_frame()?;
         let n = &self.newton;
         if n.max_iterations == 0 {
             return Err(bad("newton.max_iterations", "0", "must be >= 1"));
@@ -472,6 +497,12 @@ mod tests {
                 dem.replace("[material.assembly]", "[material.assembly]\ndensity = -1e308"),
                 "material.assembly.density",
                 "-1e308",
+            ),
+            // The current frame belongs to the updated-Lagrangian option, which sets it.
+            (
+                dem.replace("[material.assembly]", "[material.assembly]\nframe = \"current\""),
+                "material.assembly.frame",
+                "current",
             ),
         ];
         for (text, key, value) in cases {

@@ -14,7 +14,9 @@
 use super::{RunError, WorkerChoice};
 use cosdem_common::GaussPointId;
 use cosdem_common::micro::{AssemblyRequest, AssemblyState, BoundaryKind};
-use cosdem_fem::material::{Material, Regions};
+use cosdem_dem::spec::TangentFrame;
+use cosdem_fem::assembly::Kinematics;
+use cosdem_fem::material::{BiotCosserat, Material, Regions};
 use cosdem_fem::mesh::Mesh;
 use cosdem_job::{Consolidation, Job, MaterialSection};
 use cosdem_pool::Pool;
@@ -121,13 +123,19 @@ pub fn material_for(
     let mut parts: Vec<(Box<dyn Material>, Vec<GaussPointId>)> = Vec::new();
     for (m, section) in materials.iter().enumerate() {
         if let Some(e) = section.elastic() {
+            // Under the updated-Lagrangian option the objective (Biot-type) law with the same
+            // constants: it is Eq. 8 at small strain.
+            let e: Box<dyn Material> = match job.mesh.kinematics {
+                Kinematics::Small => Box::new(e),
+                Kinematics::UpdatedLagrangian => Box::new(BiotCosserat { elastic: e }),
+            };
             let own: Vec<GaussPointId> = ids
                 .iter()
                 .copied()
                 .filter(|id| element_materials[id.element as usize] == m)
                 .collect();
             if !own.is_empty() {
-                parts.push((Box::new(e), own));
+                parts.push((e, own));
             }
         }
     }
@@ -186,7 +194,12 @@ fn dem_pool(
         let MaterialSection::Dem { assembly } = materials[g.material] else {
             unreachable!("plan_specimens groups DEM points only")
         };
-        let spec = job.specimens.assembly_of(assembly, g.specimen, g.confining_stress);
+        let mut spec = job.specimens.assembly_of(assembly, g.specimen, g.confining_stress);
+        if job.mesh.kinematics == Kinematics::UpdatedLagrangian {
+            // The tangent the FE needs on the current configuration: convected, with the
+            // polar sub-step path and the objective shortcut.
+            spec.frame = TangentFrame::Current;
+        }
         // The disc count from the spec, so that a worker checks its limits before building
         // and the pool splits and times its requests by it.
         let request = AssemblyRequest {

@@ -10,11 +10,13 @@
 //! [`CosseratOperator`]: crate::assembly::CosseratOperator
 //! [`Pattern`]: crate::assembly::Pattern
 
+mod current;
 mod dofs;
 mod gauss;
 mod operator;
 mod pattern;
 
+pub use current::Kinematics;
 pub use dofs::{Component, DofMap, Field};
 pub use gauss::GaussData;
 pub use operator::{Assembled, CosseratOperator};

@@ -1,6 +1,10 @@
 //! The local assembler of the Cosserat (or Cauchy) continuum: B matrix, Gauss-point
 //! kinematics, element internal force and tangent, scattered into global arrays.
 
+use super::current::{
+    Kinematics, PolarRotation, add_geometric_stiffness, current_gradients, deformation_gradient,
+    det, polar_angle, polar_angle_derivative,
+};
 use super::{DofMap, Field, GaussData, Pattern};
 use crate::material::MaterialInput;
 use crate::mesh::Mesh;
@@ -9,6 +13,9 @@ use cosdem_common::{MacroDeformation, MicroResponse};
 
 /// Largest element dof count (9 nodes x 3 dofs).
 const MAX_ND: usize = 27;
+
+/// Largest element node count.
+const MAX_NODES: usize = 9;
 
 /// Internal force and the predictor load of one assembly pass.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -25,6 +32,8 @@ pub struct Assembled {
 pub struct CosseratOperator {
     /// Cosserat (`u_x, u_y, w`) or Cauchy (`u_x, u_y`).
     pub field: Field,
+    /// Small strain (reference configuration) or updated Lagrangian.
+    pub kinematics: Kinematics,
 }
 
 impl CosseratOperator {
@@ -62,6 +71,31 @@ impl CosseratOperator {
         }
     }
 
+    /// The Cauchy field's B matrix under the updated-Lagrangian option: the strain increment
+    /// on the current configuration `de = g - dtheta Z` (`g = grad_x du`), with `dtheta` the
+    /// change of the polar angle sent as the rotation (`dtheta[a] = [d/du_ax, d/du_ay]`).
+    /// At `F = I` it is [`Field::Cauchy`]'s small-strain matrix.
+    fn b_matrix_polar(
+        n: &[f64],
+        grad: &[[f64; 2]],
+        dtheta: &[[f64; 2]],
+        b: &mut [[f64; MAX_ND]; 6],
+    ) {
+        for row in b.iter_mut() {
+            row[..n.len() * 2].fill(0.0);
+        }
+        for a in 0..n.len() {
+            let [gx, gy] = grad[a];
+            let (cx, cy) = (a * 2, a * 2 + 1);
+            b[XX][cx] = gx;
+            b[YY][cy] = gy;
+            b[XY][cx] = -dtheta[a][0];
+            b[XY][cy] = gx - dtheta[a][1];
+            b[YX][cx] = gy + dtheta[a][0];
+            b[YX][cy] = dtheta[a][1];
+        }
+    }
+
     /// Trial kinematics of every Gauss point from the nodal dofs `u` (all dofs).
     pub fn kinematics(&self, mesh: &Mesh, gauss: &GaussData, u: &[f64]) -> Vec<MaterialInput> {
         let ndf = self.field.ndf();
@@ -84,7 +118,12 @@ impl CosseratOperator {
                     }
                 }
                 if self.field == Field::Cauchy {
-                    w = 0.5 * (h[1][0] - h[0][1]);
+                    w = match self.kinematics {
+                        Kinematics::Small => 0.5 * (h[1][0] - h[0][1]),
+                        Kinematics::UpdatedLagrangian => {
+                            polar_angle(&MacroDeformation::from_gradient(h, 0.0, [0.0; 2]).f)
+                        }
+                    };
                 }
                 MaterialInput {
                     gauss_point: gauss.id(g),
@@ -96,13 +135,17 @@ impl CosseratOperator {
 
     /// Assembles `f_int` (all dofs) and, when `values` is given, the free-dof tangent into
     /// the CSC value array of `pattern` (zeroed first). With `du_c` (a full-length vector that
-    /// is non-zero only on prescribed dofs) it also returns `K_fc du_c`.
+    /// is non-zero only on prescribed dofs) it also returns `K_fc du_c`. `u` is the iterate
+    /// the `responses` answer; under [`Kinematics::UpdatedLagrangian`] the integrals are over
+    /// its configuration (every `det F` must be positive: the solver checks before the
+    /// material is called) and the tangent has the geometric part.
     pub fn assemble(
         &self,
         mesh: &Mesh,
         dofs: &DofMap,
         gauss: &GaussData,
         pattern: &Pattern,
+        u: &[f64],
         responses: &[MicroResponse],
         mut values: Option<&mut [f64]>,
         du_c: Option<&[f64]>,
@@ -122,6 +165,10 @@ impl CosseratOperator {
         let mut cb = [[0.0; MAX_ND]; 6];
         let mut ke = vec![0.0; nd * nd];
         let mut gdof = vec![0usize; nd];
+        let ul = self.kinematics == Kinematics::UpdatedLagrangian;
+        let cauchy = self.field == Field::Cauchy;
+        let mut gc = [[0.0; 2]; MAX_NODES];
+        let mut dtheta = [[0.0; 2]; MAX_NODES];
         for e in 0..mesh.n_elements() {
             let el = mesh.element_nodes(e);
             for (a, &node) in el.iter().enumerate() {
@@ -132,8 +179,31 @@ impl CosseratOperator {
             ke.fill(0.0);
             for g in e * gauss.per_element..(e + 1) * gauss.per_element {
                 let r = &responses[g];
-                let wt = gauss.weight[g];
-                self.b_matrix(gauss.shape(g), gauss.gradient(g), &mut b);
+                let (n, grad_ref) = (gauss.shape(g), gauss.gradient(g));
+                let mut wt = gauss.weight[g];
+                let mut f = [[1.0, 0.0], [0.0, 1.0]];
+                if ul {
+                    f = deformation_gradient(grad_ref, |a| {
+                        let d = el[a] * ndf;
+                        [u[d], u[d + 1]]
+                    });
+                    wt *= det(&f);
+                    current_gradients(&f, grad_ref, &mut gc[..nn]);
+                    if cauchy {
+                        let d = polar_angle_derivative(&f);
+                        for (t, gr) in dtheta.iter_mut().zip(grad_ref) {
+                            *t = [
+                                d[0][0] * gr[0] + d[0][1] * gr[1],
+                                d[1][0] * gr[0] + d[1][1] * gr[1],
+                            ];
+                        }
+                        Self::b_matrix_polar(n, &gc[..nn], &dtheta[..nn], &mut b);
+                    } else {
+                        self.b_matrix(n, &gc[..nn], &mut b);
+                    }
+                } else {
+                    self.b_matrix(n, grad_ref, &mut b);
+                }
                 for i in 0..nd {
                     let f: f64 = (0..6).map(|s| b[s][i] * r.stress[s]).sum();
                     out.f_int[gdof[i]] += f * wt;
@@ -154,6 +224,23 @@ impl CosseratOperator {
                                 }
                             }
                         }
+                    }
+                    if ul {
+                        let polar = cauchy.then_some(PolarRotation {
+                            f: &f,
+                            grad_ref,
+                            dtheta: &dtheta[..nn],
+                        });
+                        add_geometric_stiffness(
+                            &mut ke,
+                            nd,
+                            ndf,
+                            n,
+                            &gc[..nn],
+                            &r.stress,
+                            wt,
+                            polar,
+                        );
                     }
                 }
             }
@@ -210,7 +297,7 @@ mod tests {
                 for kind in [ElementKind::Q8, ElementKind::Q9, ElementKind::T6] {
                     let (mesh, dofs, gauss, _) = setup(kind, field);
                     let u: Vec<f64> = (0..dofs.n_dofs()).map(|i| seed[i % seed.len()] * (1.0 + i as f64 * 0.01)).collect();
-                    let op = CosseratOperator { field };
+                    let op = CosseratOperator { field, kinematics: Kinematics::Small };
                     let inputs = op.kinematics(&mesh, &gauss, &u);
                     let ndf = field.ndf();
                     let mut b = [[0.0; MAX_ND]; 6];
@@ -238,17 +325,17 @@ mod tests {
             SofteningElastic { elastic: ElasticCosserat::new(1e6, 0.3, 4e5, 0.1), beta: 300.0 };
         for kind in [ElementKind::Q8, ElementKind::Q9, ElementKind::T6] {
             let (mesh, dofs, gauss, pattern) = setup(kind, Field::Cosserat);
-            let op = CosseratOperator { field: Field::Cosserat };
+            let op = CosseratOperator { field: Field::Cosserat, kinematics: Kinematics::Small };
             let u: Vec<f64> =
                 (0..dofs.n_dofs()).map(|i| 1e-2 * ((i * 7 % 11) as f64 / 11.0 - 0.5)).collect();
             let trial = TrialId { step: 1, iteration: 0 };
             let f = |u: &[f64], mat: &mut SofteningElastic| {
                 let r = mat.evaluate(trial, &op.kinematics(&mesh, &gauss, u)).unwrap();
-                op.assemble(&mesh, &dofs, &gauss, &pattern, &r, None, None).f_int
+                op.assemble(&mesh, &dofs, &gauss, &pattern, u, &r, None, None).f_int
             };
             let r = mat.evaluate(trial, &op.kinematics(&mesh, &gauss, &u)).unwrap();
             let mut values = vec![0.0; pattern.nnz()];
-            op.assemble(&mesh, &dofs, &gauss, &pattern, &r, Some(&mut values), None);
+            op.assemble(&mesh, &dofs, &gauss, &pattern, &u, &r, Some(&mut values), None);
             let kmax = values.iter().fold(0.0f64, |m, v| m.max(v.abs()));
             let h = 1e-7;
             for j in [0, 5, 17, 28, dofs.n_dofs() - 1] {

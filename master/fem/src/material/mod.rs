@@ -10,11 +10,13 @@ use cosdem_common::micro::AssemblyState;
 use cosdem_common::micro::MicroSnapshot;
 use cosdem_common::{GaussPointId, MacroDeformation, MicroResponse};
 
+mod biot;
 mod elastic;
 mod failing;
 mod regions;
 mod softening;
 
+pub use biot::BiotCosserat;
 pub use elastic::ElasticCosserat;
 pub use failing::FailureInjector;
 pub use regions::{Regions, RegionsError};

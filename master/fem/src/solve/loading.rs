@@ -236,6 +236,14 @@ impl Loading {
         Ok((flag, value))
     }
 
+    /// The loading without its pressures: the dead part under the updated-Lagrangian option,
+    /// whose pressures follow the deformed edges (`solve/follower.rs`).
+    pub fn without_pressures(&self) -> Self {
+        let mut dead = self.clone();
+        dead.edge_loads.retain(|l| !matches!(l.kind, EdgeLoadKind::Pressure(_)));
+        dead
+    }
+
     /// Integrates edge and body loads (a first stage).
     pub fn vectors(&self, mesh: &Mesh, dofs: &DofMap, gauss: &GaussData) -> Result<LoadVectors> {
         self.vectors_from(mesh, dofs, gauss, None)

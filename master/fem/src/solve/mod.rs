@@ -1,6 +1,7 @@
 //! The nonlinear solve: loading, sparse linear solves, Newton-Raphson with line search and
 //! load-step cutting, and the per-step observer.
 
+mod follower;
 mod linear;
 mod loading;
 mod newton;

@@ -14,6 +14,9 @@ use cosdem_common::{GaussPointId, MicroResponse};
 #[derive(Debug)]
 pub(super) enum Failure {
     Material(Vec<(GaussPointId, String)>),
+    /// Gauss points of the iterate with `det F <= 0` or a non-finite deformation: never
+    /// sent to the material.
+    Inverted(Vec<(GaussPointId, String)>),
     NotFinite(Vec<(GaussPointId, String)>),
     Singular(String),
     MaxIterations(u32, f64),
@@ -23,6 +26,16 @@ impl Failure {
     pub(super) fn reason(&self) -> String {
         match self {
             Self::Material(p) => format!("material failed at {} gauss point(s)", p.len()),
+            Self::Inverted(p) => {
+                let mut elements: Vec<u32> = p.iter().map(|(g, _)| g.element).collect();
+                elements.dedup();
+                let list: Vec<String> = elements.iter().take(8).map(u32::to_string).collect();
+                format!(
+                    "the iterate inverts element(s) {} ({} gauss point(s) with det F <= 0)",
+                    list.join(", "),
+                    p.len()
+                )
+            }
             Self::NotFinite(p) => format!("non-finite response at {} gauss point(s)", p.len()),
             Self::Singular(s) => format!("linear solve failed: {s}"),
             Self::MaxIterations(n, r) => {
@@ -33,7 +46,7 @@ impl Failure {
 
     pub(super) fn points(self) -> Vec<(GaussPointId, String)> {
         match self {
-            Self::Material(p) | Self::NotFinite(p) => p,
+            Self::Material(p) | Self::Inverted(p) | Self::NotFinite(p) => p,
             _ => Vec::new(),
         }
     }
@@ -45,6 +58,8 @@ pub(super) struct Trial {
     pub(super) responses: Vec<MicroResponse>,
     pub(super) inputs: Vec<MaterialInput>,
     pub(super) asm: Assembled,
+    /// The external force at the iterate (follower pressures depend on it).
+    pub(super) f_ext: Vec<f64>,
     pub(super) r: Vec<f64>,
     pub(super) scale: f64,
 }
@@ -88,7 +103,6 @@ impl Solver {
         };
         // The secant update keeps a symmetric tangent symmetric (`(B de)(B de)^T`).
         let symmetric = material.is_symmetric();
-        let f_ext = self.loads.f_ext(target);
         let du_c: Vec<f64> = self
             .u
             .iter()
@@ -110,7 +124,8 @@ impl Solver {
                 Err(f) => return Ok(Attempt::Failed(f)),
             },
         };
-        let asm = self.assemble(&responses, Some(&du_c));
+        let u_n = self.u.clone();
+        let asm = self.assemble(&responses, &u_n, target, Some(&du_c));
         // Secant updates start from the material's tangent at the step's start (the converged
         // strains are the Gauss-point states').
         let mut secants: Option<Vec<PointSecant>> = self.settings.secant_updates.then(|| {
@@ -121,7 +136,7 @@ impl Solver {
                 .collect()
         });
         self.committed = Some(responses);
-        let (r0, _) = self.residual(&asm.f_int, &f_ext);
+        let (r0, _) = self.residual(&asm.f_int, &self.external(target, &u_n));
         let mut rhs: Vec<f64> = r0.iter().zip(&asm.k_fc_du).map(|(r, k)| -(r + k)).collect();
         if let Err(s) = {
             let _s = tracing::info_span!("predictor").entered();
@@ -129,7 +144,6 @@ impl Solver {
         } {
             return Ok(Attempt::Failed(Failure::Singular(s)));
         }
-        let u_n = self.u.clone();
         let mut u = u_n.clone();
         self.add_free(&mut u, &rhs, 1.0);
         for (x, d) in u.iter_mut().zip(&du_c) {
@@ -148,8 +162,8 @@ impl Solver {
             let span = tracing::info_span!("newton", iteration = k);
             let _enter = span.enter();
             let mut alpha = 1.0;
-            let Trial { responses, inputs, asm, r, scale } = loop {
-                let trial = match self.trial(material, next_trial(iteration), &u, &f_ext)? {
+            let Trial { responses, inputs, asm, f_ext, r, scale } = loop {
+                let trial = match self.trial(material, next_trial(iteration), &u, target)? {
                     Ok(t) => t,
                     Err(f) => return Ok(Attempt::Failed(f)),
                 };
@@ -227,14 +241,14 @@ impl Solver {
             if k > self.settings.max_iterations || stalled {
                 let Some((_, best_u)) = best.take().filter(|_| tolerated) else { break };
                 let (u, trial) = if best_at == k {
-                    (u, Trial { responses, inputs, asm, r, scale })
+                    (u, Trial { responses, inputs, asm, f_ext, r, scale })
                 } else {
                     // An earlier iterate was better: the material holds the last trial only,
                     // so the best one is evaluated again (from the committed state: the same
                     // answer unless the material warm-starts) and accepted if it is still
                     // tolerated.
                     let trial =
-                        match self.trial(material, next_trial(iteration), &best_u, &f_ext)? {
+                        match self.trial(material, next_trial(iteration), &best_u, target)? {
                             Ok(t) => t,
                             Err(f) => return Ok(Attempt::Failed(f)),
                         };
@@ -245,7 +259,7 @@ impl Solver {
                     }
                     (best_u, trial)
                 };
-                self.accept(u, &trial.inputs, trial.responses, &trial.asm.f_int, &f_ext);
+                self.accept(u, &trial.inputs, trial.responses, &trial.asm.f_int, &trial.f_ext);
                 return Ok(Attempt::Converged {
                     iterations: k,
                     residuals,
@@ -266,10 +280,10 @@ impl Solver {
                 // is the answers' own; only the matrix changes).
                 let mut updated = responses.clone();
                 for ((p, i), r) in secants.iter_mut().zip(&inputs).zip(&mut updated) {
-                    p.advance(i.deformation.strain(), r.stress);
+                    p.advance(self.strain_of(&i.deformation), r.stress);
                     r.tangent = p.matrix;
                 }
-                self.assemble(&updated, None);
+                self.assemble(&updated, &u, target, None);
             }
             let mut rhs: Vec<f64> = r.iter().map(|x| -x).collect();
             if let Err(s) = self.linear.solve(&self.values, &mut rhs, symmetric) {

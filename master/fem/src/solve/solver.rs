@@ -6,12 +6,13 @@
 //! [`Solver::run`] loops over load steps; each step is a predictor plus Newton iterations,
 //! then `commit`, reactions and the observer call.
 
+use super::follower::Followers;
 use super::linear::LinearSolver;
 use super::loading::{LoadVectors, Loading};
 use super::newton::Attempt;
 use super::observer::{GaussPointState, SolutionView, StepControl, StepObserver, StepReport};
 use super::settings::SolverSettings;
-use crate::assembly::{CosseratOperator, DofMap, Field, GaussData, Pattern};
+use crate::assembly::{CosseratOperator, DofMap, Field, GaussData, Kinematics, Pattern};
 use crate::element::{ElementKind, QuadratureRule};
 use crate::error::{Error, Result};
 use crate::material::Material;
@@ -30,6 +31,8 @@ pub struct Model {
     pub rule: QuadratureRule,
     /// Boundary conditions and loads.
     pub loading: Loading,
+    /// Small strain (the paper's) or updated Lagrangian.
+    pub kinematics: Kinematics,
 }
 
 /// The evolving state of a [`Solver`] at a converged step (see [`Solver::state`]).
@@ -73,6 +76,9 @@ pub struct Solver {
     pub(super) pattern: Pattern,
     pub(super) linear: LinearSolver,
     pub(super) loads: LoadVectors,
+    /// Pressures that follow the deformed edges (updated Lagrangian; empty under small
+    /// strain, where `loads` holds them).
+    pub(super) followers: Followers,
     pub(super) values: Vec<f64>,
     /// Converged nodal dofs (all dofs).
     pub(super) u: Vec<f64>,
@@ -110,7 +116,7 @@ impl Solver {
         let (prescribed, _) = model.loading.prescribed(&model.mesh, model.field)?;
         let dofs = DofMap::new(model.field, model.mesh.n_nodes(), &prescribed);
         let gauss = GaussData::new(&model.mesh, model.rule)?;
-        let loads = model.loading.vectors(&model.mesh, &dofs, &gauss)?;
+        let (loads, followers) = Self::load_vectors(&model, &model.loading, &dofs, &gauss, None)?;
         let pattern = Pattern::new(&model.mesh, &dofs);
         let linear = LinearSolver::new(&pattern)?;
         let states = (0..gauss.len())
@@ -132,7 +138,7 @@ impl Solver {
         );
         let first_increment = 1.0 / settings.steps as f64;
         Ok(Self {
-            operator: CosseratOperator { field: model.field },
+            operator: CosseratOperator { field: model.field, kinematics: model.kinematics },
             values: vec![0.0; pattern.nnz()],
             u: vec![0.0; dofs.n_dofs()],
             model,
@@ -142,6 +148,7 @@ impl Solver {
             pattern,
             linear,
             loads,
+            followers,
             lambda: 0.0,
             step: 0,
             stage: 0,
@@ -152,6 +159,26 @@ impl Solver {
             reactions: BTreeMap::new(),
             evaluated_steps: std::cell::Cell::new(0),
         })
+    }
+
+    /// The dead load vectors of `loading` and, under the updated-Lagrangian option, its
+    /// pressures as follower loads (taken out of the dead vectors).
+    pub(super) fn load_vectors(
+        model: &Model,
+        loading: &Loading,
+        dofs: &DofMap,
+        gauss: &GaussData,
+        start: Option<&[f64]>,
+    ) -> Result<(LoadVectors, Followers)> {
+        match model.kinematics {
+            Kinematics::Small => {
+                Ok((loading.vectors_from(&model.mesh, dofs, gauss, start)?, Followers::default()))
+            }
+            Kinematics::UpdatedLagrangian => Ok((
+                loading.without_pressures().vectors_from(&model.mesh, dofs, gauss, start)?,
+                Followers::new(loading, &model.mesh)?,
+            )),
+        }
     }
 
     /// The model.
@@ -365,6 +392,7 @@ impl Solver {
                         return Err(Error::StepTooSmall {
                             step,
                             load_factor: self.lambda,
+                            displacement: self.largest_prescribed(target),
                             increment: tried,
                             min_increment,
                             reason: failure.reason(),

@@ -78,8 +78,9 @@ impl Solver {
         } else {
             Some(DofMap::new(field, self.model.mesh.n_nodes(), &prescribed))
         };
-        let loads = loading.vectors_from(
-            &self.model.mesh,
+        let (loads, followers) = Self::load_vectors(
+            &self.model,
+            &loading,
             dofs.as_ref().unwrap_or(&self.dofs),
             &self.gauss,
             Some(&start),
@@ -93,6 +94,7 @@ impl Solver {
             tracing::info!(free_dofs = self.dofs.n_free, "dof numbering rebuilt for the stage");
         }
         self.loads = loads;
+        self.followers = followers;
         self.model.loading = loading;
         self.settings = settings;
         Ok(())

@@ -4,7 +4,7 @@
 
 use super::newton::{Failure, Trial};
 use super::solver::Solver;
-use crate::assembly::Assembled;
+use crate::assembly::{Assembled, Kinematics};
 use crate::error::{Error, Result};
 use crate::material::{Material, MaterialError, MaterialInput, TrialId};
 use cosdem_common::MicroResponse;
@@ -27,6 +27,22 @@ impl Solver {
         u: &[f64],
     ) -> Result<std::result::Result<Evaluation, Failure>> {
         let inputs = self.operator.kinematics(&self.model.mesh, &self.gauss, u);
+        // Under the updated-Lagrangian option an inverted point has no current configuration
+        // to integrate on: it is never sent to the material (no det F is clamped). Under
+        // small strain the material decides, as before (the pool refuses det F <= 0, an
+        // analytical law answers).
+        let checked =
+            if self.model.kinematics == Kinematics::UpdatedLagrangian { &inputs[..] } else { &[] };
+        let inverted: Vec<_> = checked
+            .iter()
+            .filter_map(|i| {
+                let why = i.deformation.validate().err()?;
+                Some((i.gauss_point, format!("element {} inverted: {why}", i.gauss_point.element)))
+            })
+            .collect();
+        if !inverted.is_empty() {
+            return Ok(Err(Failure::Inverted(inverted)));
+        }
         match material.evaluate(trial, &inputs) {
             Ok(r) if r.len() != inputs.len() => {
                 Err(Error::ResponseCount { expected: inputs.len(), got: r.len() })
@@ -48,21 +64,66 @@ impl Solver {
     }
 
     /// Residual, internal force and tangent values (into `self.values`) from the Gauss-point
-    /// responses; `du_c` is the prescribed increment of the predictor, if any.
+    /// responses at `u`; `du_c` is the prescribed increment of the predictor, if any. Under
+    /// the updated-Lagrangian option the tangent includes the follower pressures' stiffness at
+    /// load factor `lambda`.
     pub(super) fn assemble(
         &mut self,
         responses: &[MicroResponse],
+        u: &[f64],
+        lambda: f64,
         du_c: Option<&[f64]>,
     ) -> Assembled {
-        self.operator.assemble(
+        let mut asm = self.operator.assemble(
             &self.model.mesh,
             &self.dofs,
             &self.gauss,
             &self.pattern,
+            u,
             responses,
             Some(&mut self.values),
             du_c,
-        )
+        );
+        if !self.followers.is_empty() {
+            self.followers.add_stiffness(
+                &self.dofs,
+                &self.pattern,
+                lambda,
+                Some(&mut self.values),
+                du_c,
+                &mut asm.k_fc_du,
+            );
+        }
+        asm
+    }
+
+    /// External force at load factor `lambda` and displacements `u` (the follower pressures
+    /// depend on `u`; the dead loads do not).
+    pub(super) fn external(&self, lambda: f64, u: &[f64]) -> Vec<f64> {
+        let mut f = self.loads.f_ext(lambda);
+        if !self.followers.is_empty() {
+            self.followers.add_force(&self.model.mesh, self.dofs.field.ndf(), u, lambda, &mut f);
+        }
+        f
+    }
+
+    /// The strain a Gauss-point state records and the secant updates measure: the Cosserat
+    /// strain under small strain, the objective stretch strain `R(w)^T F - I` under the
+    /// updated-Lagrangian option (a rigid rotation is no strain).
+    pub(super) fn strain_of(&self, d: &cosdem_common::MacroDeformation) -> [f64; 6] {
+        match self.model.kinematics {
+            Kinematics::Small => d.strain(),
+            Kinematics::UpdatedLagrangian => d.stretch_strain(),
+        }
+    }
+
+    /// The largest magnitude of a prescribed dof value at load factor `lambda` (the platen
+    /// displacement of a compression), for the error that ends a run.
+    pub(super) fn largest_prescribed(&self, lambda: f64) -> f64 {
+        (0..self.loads.prescribed.len())
+            .filter(|&k| self.loads.prescribed[k])
+            .map(|k| self.loads.prescribed_at(k, lambda).abs())
+            .fold(0.0, f64::max)
     }
 
     /// Residual on the free dofs and the force scale of the convergence criterion.
@@ -77,21 +138,23 @@ impl Solver {
         (r, scale)
     }
 
-    /// Evaluates the material at `u` and assembles residual and matrix there.
+    /// Evaluates the material at `u` and assembles residual and matrix there, at load factor
+    /// `lambda`.
     pub(super) fn trial(
         &mut self,
         material: &mut dyn Material,
         trial: TrialId,
         u: &[f64],
-        f_ext: &[f64],
+        lambda: f64,
     ) -> Result<std::result::Result<Trial, Failure>> {
         let (responses, inputs) = match self.evaluate(material, trial, u)? {
             Ok(e) => e,
             Err(f) => return Ok(Err(f)),
         };
-        let asm = self.assemble(&responses, None);
-        let (r, scale) = self.residual(&asm.f_int, f_ext);
-        Ok(Ok(Trial { responses, inputs, asm, r, scale }))
+        let asm = self.assemble(&responses, u, lambda, None);
+        let f_ext = self.external(lambda, u);
+        let (r, scale) = self.residual(&asm.f_int, &f_ext);
+        Ok(Ok(Trial { responses, inputs, asm, f_ext, r, scale }))
     }
 
     /// Stores the converged state: dofs, Gauss-point states (from the kinematics `inputs` at
@@ -104,8 +167,10 @@ impl Solver {
         f_int: &[f64],
         f_ext: &[f64],
     ) {
-        for ((s, i), r) in self.states.iter_mut().zip(inputs).zip(&responses) {
-            s.strain = i.deformation.strain();
+        let strains: Vec<[f64; 6]> =
+            inputs.iter().map(|i| self.strain_of(&i.deformation)).collect();
+        for ((s, e), r) in self.states.iter_mut().zip(strains).zip(&responses) {
+            s.strain = e;
             s.stress = r.stress;
             s.diagnostics = r.diagnostics.clone();
         }
@@ -141,8 +206,9 @@ impl Solver {
         };
         let material_s = t.elapsed().as_secs_f64();
         let t = std::time::Instant::now();
-        let asm = self.assemble(&responses, None);
-        let f_ext = self.loads.f_ext(1.0);
+        let u = self.u.clone();
+        let asm = self.assemble(&responses, &u, 1.0, None);
+        let f_ext = self.external(1.0, &u);
         let (r, _) = self.residual(&asm.f_int, &f_ext);
         let assembly_s = t.elapsed().as_secs_f64();
         let t = std::time::Instant::now();

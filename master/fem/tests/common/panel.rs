@@ -15,7 +15,13 @@ use cosdem_fem::solve::{Loading, Model, Platens, SolverSettings};
 pub fn panel(top_uy: f64) -> Model {
     let mesh = Mesh::rectangle(ElementKind::Q8, 1.0, 1.0, 2, 2, [0.0, 0.0]).unwrap();
     let loading = Loading::compression(top_uy, 0.0, Platens::Rough);
-    Model { mesh, field: Field::Cosserat, rule: QuadratureRule::Gauss2x2, loading }
+    Model {
+        mesh,
+        field: Field::Cosserat,
+        rule: QuadratureRule::Gauss2x2,
+        loading,
+        kinematics: Default::default(),
+    }
 }
 
 /// The elastic test material of the Newton tests (shear modulus 1e7 Pa, Poisson's ratio 0.3,

@@ -22,7 +22,13 @@ pub fn fe_panel(n: usize) -> cosdem_fem::Result<(Solver, ElasticCosserat)> {
         ],
         ..Default::default()
     };
-    let model = Model { mesh, field: Field::Cosserat, rule: QuadratureRule::Gauss2x2, loading };
+    let model = Model {
+        mesh,
+        field: Field::Cosserat,
+        rule: QuadratureRule::Gauss2x2,
+        loading,
+        kinematics: Default::default(),
+    };
     let solver = Solver::new(model, SolverSettings::default())?;
     Ok((solver, ElasticCosserat::new(1e7, 0.3, 5e6, 0.01)))
 }

@@ -3,8 +3,12 @@
 
 /// Building an assembly from its spec (packings, masses, time step).
 mod build;
+/// Perturbation columns and shortcut answers in the reference or the current frame.
+mod frame;
 /// Byte encoding and snapshots.
 mod io;
+/// The polar sub-step path of the current frame.
+mod path;
 /// Answers without a relaxation: the skip threshold and the elastic shortcut.
 mod shortcut;
 /// The trial solve: affine predictor, relaxation, homogenization, tangents.

@@ -5,8 +5,8 @@ use crate::contact::rolling;
 use crate::error::{Error, Result};
 use crate::homogenize::{Homogenized, homogenize};
 use crate::integrate::{self, RelaxReport};
-use crate::spec::{BoundarySpec, MAX_SUBSTEPS, RelaxationSpec, TangentKind};
-use cosdem_common::voigt::{KX, KY, N, XX, XY, YX, YY};
+use crate::spec::{BoundarySpec, MAX_SUBSTEPS, RelaxationSpec, TangentFrame, TangentKind};
+use cosdem_common::voigt::N;
 use cosdem_common::{MacroDeformation, MicroDiagnostics, MicroResponse};
 use std::time::Instant;
 
@@ -58,11 +58,11 @@ impl Assembly {
             TangentKind::SlidingAware => (h.sliding_aware, 0),
             TangentKind::Secant => (self.secant_tangent(&h.paper, &h.stress, target), 0),
             TangentKind::Perturbation { strain } => {
-                self.perturbation_tangent(&st, strain, rep.steps)?
+                self.perturbation_tangent(&st, &h.stress, strain, rep.steps)?
             }
             TangentKind::Adaptive { sliding, strain } => {
                 if h.fabric.contacts > 0 && h.fabric.sliding_fraction >= sliding {
-                    self.perturbation_tangent(&st, strain, rep.steps)?
+                    self.perturbation_tangent(&st, &h.stress, strain, rep.steps)?
                 } else {
                     (h.paper, 0)
                 }
@@ -101,28 +101,6 @@ impl Assembly {
         Ok(MicroResponse { stress: h.stress, tangent, diagnostics })
     }
 
-    /// The paper tangent `paper` scaled by the secant ratio from the committed relaxed state
-    /// to the trial answer `stress` at `target` ([`TangentKind::Secant`]).
-    fn secant_tangent(
-        &self,
-        paper: &cosdem_common::Tangent,
-        stress: &cosdem_common::StressVector,
-        target: &MacroDeformation,
-    ) -> cosdem_common::Tangent {
-        let Some(c) = &self.committed.relaxed else { return *paper };
-        let (e1, e0) = (target.strain(), self.committed.target.strain());
-        let de: [f64; N] = std::array::from_fn(|i| e1[i] - e0[i]);
-        let work: f64 = (0..N).map(|i| (stress[i] - c.stress[i]) * de[i]).sum();
-        let elastic: f64 =
-            (0..N).map(|i| de[i] * (0..N).map(|j| paper[i][j] * de[j]).sum::<f64>()).sum();
-        if !(work > 0.0 && elastic > 0.0) {
-            return *paper;
-        }
-        let (lo, hi) = crate::spec::SECANT_RANGE;
-        let s = (work / elastic).clamp(lo, hi);
-        paper.map(|row| row.map(|v| s * v))
-    }
-
     /// Homogenized stress, tangents and fabric of a state.
     pub fn homogenized(&self, st: &State) -> Homogenized {
         let d = &st.dynamics;
@@ -138,7 +116,8 @@ impl Assembly {
     }
 
     /// Jumps `st` affinely to `target` and relaxes it with tolerance `tol`; with
-    /// `relaxation.substep` set, in [`Assembly::substeps`] equal jumps along the straight path,
+    /// `relaxation.substep` set, in [`Assembly::substeps`] equal jumps along the straight path
+    /// (the polar path [`super::path::interpolate_polar`] in [`TangentFrame::Current`]),
     /// each relaxed in turn (the steps of all of them are counted; the answer counts as
     /// converged only if every one converged).
     pub fn relax_to(
@@ -151,7 +130,12 @@ impl Assembly {
         let from = st.target;
         let (mut st, mut steps, mut all_converged) = (st, 0u64, true);
         for i in 1..n {
-            let t = from.interpolate(target, i as f64 / n as f64);
+            let t = match self.spec.frame {
+                TangentFrame::Reference => from.interpolate(target, i as f64 / n as f64),
+                TangentFrame::Current => {
+                    super::path::interpolate_polar(&from, target, i as f64 / n as f64)
+                }
+            };
             let (s, rep) = self.relax_capped(st, &t, tol, u64::MAX)?;
             steps = steps.saturating_add(rep.steps);
             all_converged &= rep.converged;
@@ -324,8 +308,9 @@ impl Assembly {
     }
 
     /// Central-difference tangent: twelve extra relaxations from the equilibrated trial state
-    /// `st` (left untouched), strain perturbation `h`, tolerance 1e-1 of the solve's. Returns
-    /// the tangent and the relaxation steps it took.
+    /// `st` (left untouched, its stress `stress`), strain perturbation `h`, tolerance 1e-1 of
+    /// the solve's; perturbed and, in [`TangentFrame::Current`], convected as
+    /// [`super::frame`] says. Returns the tangent and the relaxation steps it took.
     ///
     /// Each perturbed relaxation is capped at [`perturbation_cap`] steps: past a peak an
     /// assembly near a slip event can creep for the whole `max_steps` budget (measured: 880
@@ -336,6 +321,7 @@ impl Assembly {
     fn perturbation_tangent(
         &mut self,
         st: &State,
+        stress: &cosdem_common::StressVector,
         h: f64,
         main_steps: u64,
     ) -> Result<([[f64; N]; N], u64)> {
@@ -347,13 +333,19 @@ impl Assembly {
         for col in 0..N {
             let mut s = [[0.0; N]; 2];
             for (side, sign) in [(0usize, 1.0f64), (1, -1.0)] {
-                let t = perturbed(&base, col, sign * h);
+                let t = super::frame::perturbed(&base, col, sign * h, self.spec.frame);
                 let (pst, rep) = self.relax_capped(st.clone(), &t, tol, cap)?;
                 steps += rep.steps;
                 s[side] = self.homogenized(&pst).stress;
             }
             for row in 0..N {
                 c[row][col] = (s[0][row] - s[1][row]) / (2.0 * h);
+            }
+            if self.spec.frame == TangentFrame::Current {
+                let t = super::frame::transport(col, stress);
+                for row in 0..N {
+                    c[row][col] -= t[row];
+                }
             }
         }
         Ok((c, steps))
@@ -364,21 +356,6 @@ impl Assembly {
 /// the relaxation it perturbs, at least 2 000, at most the job's `max_steps`.
 pub(crate) fn perturbation_cap(main_steps: u64, max_steps: u64) -> u64 {
     main_steps.saturating_mul(4).max(2_000).min(max_steps)
-}
-
-/// `base` with Cosserat strain component `col` changed by `h` (micro-rotation fixed).
-pub(crate) fn perturbed(base: &MacroDeformation, col: usize, h: f64) -> MacroDeformation {
-    let mut t = *base;
-    match col {
-        XX => t.f[0][0] += h,
-        YY => t.f[1][1] += h,
-        XY => t.f[1][0] += h,
-        YX => t.f[0][1] += h,
-        KX => t.kappa[0] += h,
-        KY => t.kappa[1] += h,
-        _ => unreachable!(),
-    }
-    t
 }
 
 impl Assembly {

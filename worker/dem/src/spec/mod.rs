@@ -18,6 +18,7 @@
 //!                  "tolerance": 1e-4, "max_steps": 400000, "check_every": 10, "safety": 0.8,
 //!                  "density_scale": 1.0, "skin": 0.5},
 //!   "tangent": {"kind": "paper"},
+//!   "frame": "reference",
 //!   "warm_start": false
 //! }
 //! ```
@@ -46,7 +47,7 @@ pub use relaxation::{
     Criterion, Driver, FIRE_CEILING, MAX_RELAXATION_STEPS, MAX_SUBSTEPS, RelaxationSpec,
 };
 pub use size::{STATE_BYTES_PER_DISC, STATE_ENVELOPE_BYTES, STATE_FIXED_BYTES, state_bytes};
-pub use tangent::{MAX_TANGENT_STRAIN, SECANT_RANGE, TangentKind};
+pub use tangent::{MAX_TANGENT_STRAIN, SECANT_RANGE, TangentFrame, TangentKind};
 
 use crate::error::{Result, positive};
 use serde::{Deserialize, Deserializer, Serialize};
@@ -67,6 +68,10 @@ pub struct AssemblySpec {
     pub relaxation: RelaxationSpec,
     /// Which tangent operator `solve` returns.
     pub tangent: TangentKind,
+    /// The frame of the tangent, the sub-step path and the shortcut: `reference` (default,
+    /// not written) or `current` (under the FE's updated-Lagrangian kinematics).
+    #[serde(skip_serializing_if = "TangentFrame::is_reference")]
+    pub frame: TangentFrame,
     /// Start each trial solve from the last trial state (since the last commit or rollback)
     /// instead of the committed state: fewer steps per Newton iteration, but the answer then
     /// depends on the iteration history. Default false.
@@ -82,6 +87,7 @@ impl Default for AssemblySpec {
             boundary: BoundarySpec::default(),
             relaxation: RelaxationSpec::default(),
             tangent: TangentKind::default(),
+            frame: TangentFrame::Reference,
             warm_start: false,
         }
     }

@@ -46,6 +46,39 @@ pub enum TangentKind {
     },
 }
 
+/// The configuration an assembly's answer is linearised and extrapolated in (`frame` of the
+/// assembly spec; design note 2026-12-05-updated-lagrangian, sections 2.2 and 2.4).
+///
+/// The deformation sent is the total `F` from the reference in both frames; what changes is
+/// the sense of the tangent and the paths between committed and target:
+///
+/// | | `reference` (small-strain FE) | `current` (updated-Lagrangian FE) |
+/// |---|---|---|
+/// | perturbation tangent | `F + h E`, `K + h e_i`: `d s / d e` | `(I + h E) F`, `K + h F^T e_i`, minus the transport `E s - tr(E) s + s E^T`: the convected tangent |
+/// | sub-step path | straight in `F`, `w`, `K` | polar: the increment's rotation by angle, its stretch linearly |
+/// | shortcut | `s_0 + C (e - e_0)` | `R_d [G s_0 G^T / det G + C de] R_d^T`, `G = R_d^T dF`, tangent turned by `R_d` |
+/// | secant ratio | on `e - e_0`, `s - s_0` | on `de` and `s - R_d G s_0 G^T R_d^T / det G` (a rotation is no increment) |
+///
+/// `reference` is the default and is not written (a spec without the key reads as
+/// `reference` and a `reference` spec writes the JSON it wrote before the key existed, so
+/// checkpoint digests and stored assemblies do not change).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "snake_case")]
+pub enum TangentFrame {
+    /// Derivatives with respect to the reference deformation gradient (today's behaviour).
+    #[default]
+    Reference,
+    /// Derivatives on the current configuration, objective paths and shortcut.
+    Current,
+}
+
+impl TangentFrame {
+    /// True for the default [`TangentFrame::Reference`] (which the spec does not write).
+    pub fn is_reference(&self) -> bool {
+        *self == TangentFrame::Reference
+    }
+}
+
 /// The range of the [`TangentKind::Secant`] scale: never stiffer than the contact tangent,
 /// never softer than a twentieth of it (a near-zero secant would hand Newton a singular
 /// matrix).

@@ -101,3 +101,25 @@ fn a_variant_without_settings_refuses_an_extra_key_by_name() {
     check("model", "none", TangentialModel::None);
     check("model", "none", RollingModel::None);
 }
+
+/// `frame`: absent or `reference` reads as [`TangentFrame::Reference`], which is not written
+/// (the default spec keeps its recorded JSON above, so digests of existing jobs do not
+/// change); `current` is written after `tangent` and reads back; a misspelt frame is refused
+/// naming both values.
+#[test]
+fn the_frame_is_written_only_when_current() {
+    let current = AssemblySpec { frame: TangentFrame::Current, ..AssemblySpec::default() };
+    let json = serde_json::to_string(&current).unwrap();
+    let want = RECORDED[0].replace(
+        r#""tangent":{"kind":"paper"},"#,
+        r#""tangent":{"kind":"paper"},"frame":"current","#,
+    );
+    assert_eq!(json, want);
+    assert_eq!(serde_json::from_str::<AssemblySpec>(&json).unwrap(), current);
+    let reference = serde_json::from_str::<AssemblySpec>(r#"{"frame": "reference"}"#).unwrap();
+    assert_eq!(reference, AssemblySpec::default());
+    assert_eq!(serde_json::to_string(&reference).unwrap(), RECORDED[0]);
+    let err = serde_json::from_str::<AssemblySpec>(r#"{"frame": "curent"}"#).unwrap_err();
+    let err = err.to_string();
+    assert!(err.contains("curent") && err.contains("`current`"), "{err}");
+}
