@@ -51,20 +51,16 @@ pub fn current_gradients(f: &[[f64; 2]; 2], grad: &[[f64; 2]], out: &mut [[f64; 
     }
 }
 
-/// The angle of the polar rotation of `F`, `atan2(F_yx - F_xy, F_xx + F_yy)`: the Cauchy
-/// field's micro-rotation under the updated-Lagrangian option (its linearisation at `F = I`
-/// is the small-strain `(u_y,x - u_x,y) / 2`).
-pub fn polar_angle(f: &[[f64; 2]; 2]) -> f64 {
-    (f[1][0] - f[0][1]).atan2(f[0][0] + f[1][1])
-}
-
 /// `z = (F_xx + F_yy) + i (F_yx - F_xy)`, whose argument is the polar angle; `dz` of a
 /// change `dF` likewise. Returned as `(re, im)`.
 fn z_of(f: &[[f64; 2]; 2]) -> (f64, f64) {
     (f[0][0] + f[1][1], f[1][0] - f[0][1])
 }
 
-/// `d theta / d F_ij` (row i, column j): `theta = Im log z`, so `d theta = Im(dz / z)`.
+/// `d theta / d F_ij` (row i, column j) of the polar angle `theta`
+/// ([`MacroDeformation::polar_angle`](cosdem_common::MacroDeformation::polar_angle), the
+/// Cauchy field's micro-rotation under the updated-Lagrangian option): `theta = Im log z`,
+/// so `d theta = Im(dz / z)`.
 pub fn polar_angle_derivative(f: &[[f64; 2]; 2]) -> [[f64; 2]; 2] {
     let (c, s) = z_of(f);
     let d = c * c + s * s;
@@ -165,6 +161,10 @@ pub fn add_geometric_stiffness(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn polar_angle(f: &[[f64; 2]; 2]) -> f64 {
+        cosdem_common::MacroDeformation { f: *f, w: 0.0, kappa: [0.0; 2] }.polar_angle()
+    }
 
     fn rot(a: f64) -> [[f64; 2]; 2] {
         [[a.cos(), -a.sin()], [a.sin(), a.cos()]]

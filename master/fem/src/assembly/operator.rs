@@ -3,7 +3,7 @@
 
 use super::current::{
     Kinematics, PolarRotation, add_geometric_stiffness, current_gradients, deformation_gradient,
-    det, polar_angle, polar_angle_derivative,
+    det, polar_angle_derivative,
 };
 use super::{DofMap, Field, GaussData, Pattern};
 use crate::material::MaterialInput;
@@ -121,7 +121,7 @@ impl CosseratOperator {
                     w = match self.kinematics {
                         Kinematics::Small => 0.5 * (h[1][0] - h[0][1]),
                         Kinematics::UpdatedLagrangian => {
-                            polar_angle(&MacroDeformation::from_gradient(h, 0.0, [0.0; 2]).f)
+                            MacroDeformation::from_gradient(h, 0.0, [0.0; 2]).polar_angle()
                         }
                     };
                 }

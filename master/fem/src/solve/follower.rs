@@ -141,14 +141,9 @@ mod tests {
     use crate::element::ElementKind;
     use crate::solve::EdgeLoad;
 
-    fn setup() -> (Mesh, DofMap, Pattern, Followers) {
-        let mut mesh = Mesh::rectangle(ElementKind::Q8, 1.0, 0.7, 2, 1, [0.0, 0.0]).unwrap();
-        for p in &mut mesh.nodes {
-            *p = [p[0] + 0.05 * (3.0 * p[1]).sin(), p[1] + 0.04 * (2.0 * p[0]).cos()];
-        }
-        let dofs = DofMap::new(Field::Cosserat, mesh.n_nodes(), &vec![false; mesh.n_nodes() * 3]);
-        let pattern = Pattern::new(&mesh, &dofs);
-        let loading = Loading {
+    /// 2 kPa on the right and top edges.
+    fn pressures() -> Loading {
+        Loading {
             edge_loads: ["right", "top"]
                 .map(|s| EdgeLoad {
                     set: s.into(),
@@ -157,7 +152,17 @@ mod tests {
                 })
                 .to_vec(),
             ..Default::default()
-        };
+        }
+    }
+
+    fn setup() -> (Mesh, DofMap, Pattern, Followers) {
+        let mut mesh = Mesh::rectangle(ElementKind::Q8, 1.0, 0.7, 2, 1, [0.0, 0.0]).unwrap();
+        for p in &mut mesh.nodes {
+            *p = [p[0] + 0.05 * (3.0 * p[1]).sin(), p[1] + 0.04 * (2.0 * p[0]).cos()];
+        }
+        let dofs = DofMap::new(Field::Cosserat, mesh.n_nodes(), &vec![false; mesh.n_nodes() * 3]);
+        let pattern = Pattern::new(&mesh, &dofs);
+        let loading = pressures();
         let f = Followers::new(&loading, &mesh).unwrap();
         (mesh, dofs, pattern, f)
     }
@@ -167,16 +172,7 @@ mod tests {
     #[test]
     fn at_the_reference_it_is_the_dead_load() {
         let (mesh, dofs, _, f) = setup();
-        let loading = Loading {
-            edge_loads: ["right", "top"]
-                .map(|s| EdgeLoad {
-                    set: s.into(),
-                    kind: EdgeLoadKind::Pressure(2e3),
-                    ramp: Ramp::Linear,
-                })
-                .to_vec(),
-            ..Default::default()
-        };
+        let loading = pressures();
         let rule = crate::element::QuadratureRule::Gauss2x2;
         let gauss = crate::assembly::GaussData::new(&mesh, rule).unwrap();
         let dead = loading.vectors(&mesh, &dofs, &gauss).unwrap().f_ext(0.6);
