@@ -49,8 +49,8 @@ const EXAMPLES: &[(&str, u64)] = &[
     ("scene-a-post-peak-ul", 25),
     // 1.7 s for step 1 (400 points x 105 discs), the next four cheaper.
     ("panel-5m", 5),
-    // Staged jobs (issue 28), K = 2 each. 6.4 s for steps 1-2 (112 points x 147 discs, surcharge
-    // then the first push).
+    // Staged jobs (issue 28), K = 2 each. Steps 1-2 of the footing: the surcharge then the
+    // first push, on its mixed mesh (164 points x 147 discs).
     ("footing", 2),
     // 1.0 s for steps 1-2 (32 points x 147 discs, at rest then the first active step).
     ("retaining-wall", 2),

@@ -1,9 +1,10 @@
 //! Patch tests: a linear displacement field with its continuum rotation (constant strain),
 //! and linear displacement and micro-rotation fields with `Gc = 0` (constant strain and
 //! curvature), prescribed on the boundary of a distorted 3x3 patch, are reproduced at every
-//! interior node and Gauss point to round-off, for Q8 (2x2 reduced), Q9 (3x3) and the
-//! 6-node triangle with its 3-point (reduced) and 6-point (full) rules. The largest errors
-//! are printed (`--nocapture`).
+//! interior node and Gauss point to round-off, for Q8 (2x2 reduced), Q9 (3x3), the 6-node
+//! triangle with its 3-point (reduced) and 6-point (full) rules, and meshes mixing Q8 or Q9
+//! with triangles (each family on its rule of that role). The largest errors are printed
+//! (`--nocapture`).
 //!
 //! Why `Gc = 0` for constant curvature: a linear `w` makes `e_xy - e_yx = u_y,x - u_x,y - 2w`
 //! linear, so with `Gc > 0` the skew stress `s_xy - s_yx = 2 Gc (e_xy - e_yx)` varies and the
@@ -13,14 +14,22 @@
 
 mod common;
 
-use common::{ELEMENTS, TRIANGLES, boundary_values, distorted_square};
+use common::{
+    ELEMENTS, MIXED, TRIANGLES, boundary_values, distorted_mixed_square, distorted_square,
+};
 use cosdem_fem::assembly::Field;
 use cosdem_fem::material::ElasticCosserat;
 use cosdem_fem::solve::{Model, Solver, SolverSettings};
 
 fn patch(field: Field, material: ElasticCosserat, exact: fn([f64; 2]) -> [f64; 3]) {
-    for (kind, rule) in ELEMENTS.into_iter().chain(TRIANGLES) {
-        let mesh = distorted_square(kind);
+    let uniform = ELEMENTS.into_iter().chain(TRIANGLES).map(|(k, r)| (k, distorted_square(k), r));
+    let mixed = MIXED.into_iter().map(|(k, r)| (k, distorted_mixed_square(k), r));
+    for (kind, mesh, rule) in uniform.chain(mixed) {
+        let kind = if mesh.uniform_kind().is_some() {
+            format!("{kind:?}")
+        } else {
+            format!("{kind:?}+T6")
+        };
         let loading = boundary_values(&mesh, field, exact);
         let model = Model { mesh, field, rule, loading, kinematics: Default::default() };
         let settings = SolverSettings { steps: 1, ..Default::default() };
@@ -36,7 +45,7 @@ fn patch(field: Field, material: ElasticCosserat, exact: fn([f64; 2]) -> [f64; 3
             for c in 0..ndf {
                 let err = (view.dofs[n * ndf + c] - ex[c]).abs();
                 worst_node = worst_node.max(err);
-                assert!(err < 1e-10 * scale, "{kind:?} {field:?} node {n} comp {c}: error {err:e}");
+                assert!(err < 1e-10 * scale, "{kind} {field:?} node {n} comp {c}: error {err:e}");
             }
         }
         let s0 = view.gauss_points[0].stress;
@@ -47,18 +56,18 @@ fn patch(field: Field, material: ElasticCosserat, exact: fn([f64; 2]) -> [f64; 3
                 worst_strain = worst_strain.max((g.strain[k] - e[k]).abs());
                 assert!(
                     (g.strain[k] - e[k]).abs() < 1e-10 * scale,
-                    "{kind:?} strain {k} at {}",
+                    "{kind} strain {k} at {}",
                     g.id
                 );
                 assert!(
                     (g.stress[k] - s0[k]).abs() < 1e-10 * smax,
-                    "{kind:?} stress {k} at {}",
+                    "{kind} stress {k} at {}",
                     g.id
                 );
             }
         }
         println!(
-            "{kind:?} {rule:?} {field:?}: largest nodal error {worst_node:.2e}, strain error \
+            "{kind} {rule:?} {field:?}: largest nodal error {worst_node:.2e}, strain error \
              {worst_strain:.2e} (field scale {scale:e})"
         );
     }

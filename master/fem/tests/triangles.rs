@@ -41,7 +41,7 @@ fn gmsh_t6_formats_22_and_41_agree_and_keep_their_sets() {
     assert_eq!(v22.elements[0].physicals, ["lower"]);
     assert_eq!(v22.elements[1].physicals, ["upper"]);
     let mesh = Mesh::from_description(v22.into()).unwrap();
-    assert_eq!(mesh.kind, ElementKind::T6);
+    assert_eq!(mesh.uniform_kind(), Some(ElementKind::T6));
     assert_eq!(mesh.n_elements(), 2);
     assert_eq!(mesh.element_set("lower").unwrap(), [0]);
     assert_eq!(mesh.element_set("upper").unwrap(), [1]);
@@ -151,8 +151,8 @@ fn clockwise_triangle_is_reoriented() {
 }
 
 /// Bad elements are errors naming the element (its Gmsh tag and line in a file, its index
-/// in a description): corners on a line, a mid-side node far off its edge, triangles mixed
-/// with quadrilaterals, a first-order triangle (with the hint to mesh second order).
+/// in a description): corners on a line, a mid-side node far off its edge, an element of
+/// a node count no kind has, a first-order triangle (with the hint to mesh second order).
 #[test]
 fn bad_triangles_are_named() {
     // Node 3 at (2, 0): element 4's corners (0,0), (1,0), (2,0) are collinear.
@@ -164,26 +164,6 @@ fn bad_triangles_are_named() {
     assert!(matches!(err, GmshError::DistortedElement { element: 4, .. }), "{err}");
     let msg = err.to_string();
     assert!(msg.contains(":29: element 4 is distorted: mid-side node 3"), "{msg}");
-
-    // An 8-node quadrilateral right of the square.
-    let mixed = V22
-        .replace(
-            "9 0.5 0.5 0\n",
-            "9 0.5 0.5 0\n10 2 0 0\n11 2 1 0\n12 1.5 0 0\n13 2 0.5 0\n14 1.5 1 0\n",
-        )
-        .replace("$Nodes\n9\n", "$Nodes\n14\n")
-        .replace("$Elements\n5\n", "$Elements\n6\n")
-        .replace("$EndElements", "6 16 2 10 1 2 10 11 3 12 13 14 6\n$EndElements");
-    let err = parse_msh(&mixed).unwrap_err();
-    let msg = err.to_string();
-    assert!(matches!(err, GmshError::MixedElements { first: 4, other: 6, .. }), "{msg}");
-    assert!(
-        msg.contains(
-            "mixed meshes are not supported yet: element 4 is a 6-node triangle, \
-                      element 6 a 8-node quadrangle"
-        ),
-        "{msg}"
-    );
 
     // First order.
     let linear = V22.replace("4 9 2 10 1 1 2 3 5 6 9", "4 2 2 10 1 1 2 3");
@@ -201,10 +181,10 @@ fn bad_triangles_are_named() {
     flat.nodes[2] = [2.0, 0.0];
     let msg = Mesh::from_description(flat).unwrap_err().to_string();
     assert!(msg.contains("elements = 0: zero area"), "{msg}");
-    let mut mixed = desc;
-    mixed.elements.push(vec![0, 1, 2, 3, 4, 5, 6, 7]);
-    let msg = Mesh::from_description(mixed).unwrap_err().to_string();
-    assert!(msg.contains("elements = 2: 8 nodes, mesh is T6"), "{msg}");
+    let mut seven = desc;
+    seven.elements.push(vec![0, 1, 2, 3, 4, 5, 6]);
+    let msg = Mesh::from_description(seven).unwrap_err().to_string();
+    assert!(msg.contains("elements = 2: 7 nodes; expected 8 (Q8), 9 (Q9) or 6 (T6)"), "{msg}");
 }
 
 /// A quadrilateral rule on a triangle mesh (and the reverse) is refused, naming the rule

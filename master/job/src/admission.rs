@@ -93,6 +93,9 @@ pub const DISK_WARNING_FILES: f64 = 100_000.0;
 const MIB: f64 = (1u64 << 20) as f64;
 const GIB: f64 = (1u64 << 30) as f64;
 
+/// The element kinds [`MeshCounts::by_kind`] counts, in its order.
+pub const KINDS: [ElementKind; 3] = [ElementKind::Q8, ElementKind::Q9, ElementKind::T6];
+
 /// The size of the mesh: what the estimate needs of it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MeshCounts {
@@ -100,11 +103,9 @@ pub struct MeshCounts {
     pub elements: f64,
     /// Nodes.
     pub nodes: f64,
-    /// Nodes per element (8, 9 or 6).
-    pub nodes_per_element: f64,
-    /// The element family: it sets the Gauss points per element
-    /// ([`MeshCounts::points_per_element`]).
-    pub kind: ElementKind,
+    /// Elements of each of [`KINDS`]: the kind sets the element's nodes and Gauss points
+    /// ([`MeshCounts::gauss_points`]).
+    pub by_kind: [f64; 3],
 }
 
 impl MeshCounts {
@@ -122,30 +123,38 @@ impl MeshCounts {
         // Q8 lacks the cells' centres; Q9 has every node of the (2 nx + 1) x (2 ny + 1) grid;
         // T6 too (a cell's diagonal has its mid-side at the centre), in two triangles a cell.
         let (elements, nodes, kind) = match m.element {
-            ElementChoice::Q8 => (nx * ny, grid - nx * ny, ElementKind::Q8),
-            ElementChoice::Q9 => (nx * ny, grid, ElementKind::Q9),
-            ElementChoice::T6 => (2.0 * nx * ny, grid, ElementKind::T6),
+            ElementChoice::Q8 => (nx * ny, grid - nx * ny, 0),
+            ElementChoice::Q9 => (nx * ny, grid, 1),
+            ElementChoice::T6 => (2.0 * nx * ny, grid, 2),
         };
-        Some(Self { elements, nodes, nodes_per_element: kind.nodes() as f64, kind })
+        let mut by_kind = [0.0; 3];
+        by_kind[kind] = elements;
+        Some(Self { elements, nodes, by_kind })
     }
 
     /// The counts of a built mesh.
     pub fn of_mesh(mesh: &Mesh) -> Self {
-        Self {
-            elements: mesh.n_elements() as f64,
-            nodes: mesh.n_nodes() as f64,
-            nodes_per_element: mesh.kind.nodes() as f64,
-            kind: mesh.kind,
-        }
+        let by_kind = KINDS.map(|k| mesh.kinds.iter().filter(|&&e| e == k).count() as f64);
+        Self { elements: mesh.n_elements() as f64, nodes: mesh.n_nodes() as f64, by_kind }
     }
 
-    /// Gauss points per element under `integration`: those of the rule the solver takes
-    /// ([`QuadratureRule::for_kind`]), 4 (`reduced`, 2 x 2) or 9 (`full`, 3 x 3) per
+    /// Gauss points under `integration`: each element has those of the rule the solver gives
+    /// its kind ([`QuadratureRule::for_kind`]), 4 (`reduced`, 2 x 2) or 9 (`full`, 3 x 3) per
     /// quadrilateral, 3 or 6 per triangle.
-    pub fn points_per_element(&self, integration: Integration) -> f64 {
-        let rule = QuadratureRule::for_kind(self.kind, integration == Integration::Full);
-        Quadrature::new(rule).len() as f64
+    pub fn gauss_points(&self, integration: Integration) -> f64 {
+        self.sum(|k| points_of(k, integration))
     }
+
+    /// `sum over elements of f(kind)`.
+    fn sum(&self, f: impl Fn(ElementKind) -> f64) -> f64 {
+        KINDS.iter().zip(&self.by_kind).filter(|(_, n)| **n > 0.0).map(|(&k, n)| n * f(k)).sum()
+    }
+}
+
+/// Gauss points of an element of `kind` under `integration`.
+fn points_of(kind: ElementKind, integration: Integration) -> f64 {
+    let rule = QuadratureRule::for_kind(kind, integration == Integration::Full);
+    Quadrature::new(rule).len() as f64
 }
 
 /// One part of the memory estimate.
@@ -283,8 +292,7 @@ fn packing_keys(p: &PackingSpec) -> Vec<String> {
 /// allocated. No file is read; the one input besides the job is the number of cores when
 /// `[workers] in_process = 0` (random packings built at once).
 pub fn estimate(job: &Job, mesh: MeshCounts) -> Estimate {
-    let points_per_element = mesh.points_per_element(job.mesh.integration);
-    let gauss_points = mesh.elements * points_per_element;
+    let gauss_points = mesh.gauss_points(job.mesh.integration);
     let mut point_keys = mesh_keys(job);
     if job.mesh.integration == Integration::Full {
         point_keys.push("mesh.integration = \"full\"".into());
@@ -297,9 +305,13 @@ pub fn estimate(job: &Job, mesh: MeshCounts) -> Estimate {
         crate::Continuum::Cosserat => 3.0,
         crate::Continuum::Cauchy => 2.0,
     };
-    let scale = ((mesh.nodes_per_element * dofs) / 24.0).powi(2).max(points_per_element / 4.0);
-    let per_element =
-        (FE_BYTES_PER_ELEMENT + FE_BYTES_PER_ELEMENT_LOG2 * mesh.elements.max(1.0).log2()) * scale;
+    let scale = |k: ElementKind| {
+        ((k.nodes() as f64 * dofs) / 24.0).powi(2).max(points_of(k, job.mesh.integration) / 4.0)
+    };
+    let per_element = (FE_BYTES_PER_ELEMENT
+        + FE_BYTES_PER_ELEMENT_LOG2 * mesh.elements.max(1.0).log2())
+        * mesh.sum(scale)
+        / mesh.elements.max(1.0);
     parts.push(Part {
         name: "mesh and linear system",
         bytes: FE_WORKSPACE_BYTES + mesh.elements * per_element,

@@ -144,7 +144,8 @@ impl Job {
     }
 
     /// The Gauss rule of `integration` on elements of `kind`: 2x2 (`reduced`) or 3x3 (`full`)
-    /// points on a quadrilateral, 3 or 6 on a triangle.
+    /// points on a quadrilateral, 3 or 6 on a triangle. A mixed mesh's other family takes the
+    /// rule of the same role ([`QuadratureRule::on`]).
     pub fn rule(&self, kind: ElementKind) -> QuadratureRule {
         QuadratureRule::for_kind(kind, self.mesh.integration == Integration::Full)
     }
@@ -179,7 +180,7 @@ impl Job {
             }
             false => self.loading(),
         };
-        let rule = self.rule(mesh.kind);
+        let rule = self.rule(mesh.element_kind(0));
         Ok(cosdem_fem::solve::Model {
             mesh,
             field: self.field(),

@@ -21,10 +21,11 @@ pub struct FieldData {
     pub displacements: Vec<[f64; 2]>,
     /// Element node lists (8 or 9 nodes of a quadrilateral, 6 of a triangle; Gmsh order).
     pub elements: Vec<Vec<usize>>,
-    /// Gauss points per element: 4, 9 or 16 on quadrilaterals (the tensor rule, xi running
-    /// fastest), 3 or 6 on triangles (the solver's triangle rule of that many points, in its
-    /// order: [`cosdem_fem::element::Quadrature`]).
-    pub gauss_per_element: usize,
+    /// Gauss points of each element: 4, 9 or 16 on quadrilaterals (the tensor rule, xi
+    /// running fastest), 3 or 6 on triangles (the solver's triangle rule of that many points,
+    /// in its order: [`cosdem_fem::element::Quadrature`]). Files written before meshes could
+    /// mix kinds hold one `gauss_per_element` instead; [`FieldData::read`] takes both.
+    pub gauss_points: Vec<usize>,
     /// Equivalent strain per Gauss point, element-major.
     pub equivalent_strain: Vec<f64>,
 }
@@ -42,11 +43,16 @@ impl FieldData {
     /// Reads a file written by [`FieldData::write`] and checks its sizes.
     pub fn read(path: &Path) -> Result<Self> {
         let text = std::fs::read_to_string(path).map_err(io_err(path, "read"))?;
-        let f: FieldData = serde_json::from_str(&text).map_err(|e| OutputError::InvalidData {
-            path: path.to_path_buf(),
-            message: e.to_string(),
-        })?;
         let bad = |m: String| OutputError::InvalidData { path: path.to_path_buf(), message: m };
+        let mut value: serde_json::Value =
+            serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
+        if let Some(map) = value.as_object_mut()
+            && let Some(per) = map.remove("gauss_per_element")
+        {
+            let elements = map.get("elements").and_then(|e| e.as_array()).map_or(0, Vec::len);
+            map.insert("gauss_points".into(), vec![per; elements].into());
+        }
+        let f: FieldData = serde_json::from_value(value).map_err(|e| bad(e.to_string()))?;
         if f.displacements.len() != f.nodes.len() {
             return Err(bad(format!(
                 "{} displacements for {} nodes",
@@ -54,12 +60,14 @@ impl FieldData {
                 f.nodes.len()
             )));
         }
-        if f.equivalent_strain.len() != f.elements.len() * f.gauss_per_element {
+        let points: usize = f.gauss_points.iter().sum();
+        if f.gauss_points.len() != f.elements.len() || f.equivalent_strain.len() != points {
             return Err(bad(format!(
-                "{} equivalent strains for {} elements x {} points",
+                "{} equivalent strains for {} elements with {} points in all ({} counts)",
                 f.equivalent_strain.len(),
                 f.elements.len(),
-                f.gauss_per_element
+                points,
+                f.gauss_points.len()
             )));
         }
         for (e, nodes) in f.elements.iter().enumerate() {
@@ -67,15 +75,27 @@ impl FieldData {
                 return Err(bad(format!("element {e} has the nodes {nodes:?}")));
             }
             let rules: &[usize] = if nodes.len() == 6 { &[3, 6] } else { &[4, 9, 16] };
-            if !rules.contains(&f.gauss_per_element) {
+            if !rules.contains(&f.gauss_points[e]) {
                 return Err(bad(format!(
-                    "gauss_per_element = {} for element {e} of {} nodes (expected {rules:?})",
-                    f.gauss_per_element,
+                    "gauss_points = {} for element {e} of {} nodes (expected {rules:?})",
+                    f.gauss_points[e],
                     nodes.len()
                 )));
             }
         }
         Ok(f)
+    }
+
+    /// The positions of element `e`'s values in `equivalent_strain`, for every element.
+    pub fn point_ranges(&self) -> Vec<std::ops::Range<usize>> {
+        let mut start = 0;
+        self.gauss_points
+            .iter()
+            .map(|&n| {
+                start += n;
+                start - n..start
+            })
+            .collect()
     }
 }
 
@@ -93,7 +113,7 @@ mod tests {
             displacements: vec![[0.0; 2]; 6],
             nodes,
             elements: vec![(0..6).collect()],
-            gauss_per_element: per,
+            gauss_points: vec![per],
             equivalent_strain: vec![1e-3; per],
         }
     }
@@ -111,7 +131,23 @@ mod tests {
         }
         triangle(4).write(&path).unwrap();
         let e = FieldData::read(&path).unwrap_err().to_string();
-        assert!(e.contains("gauss_per_element = 4 for element 0 of 6 nodes"), "{e}");
+        assert!(e.contains("gauss_points = 4 for element 0 of 6 nodes"), "{e}");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    /// A file of the older form (one `gauss_per_element` for all elements) reads as the
+    /// same count for each element, so earlier run directories still plot.
+    #[test]
+    fn a_file_with_gauss_per_element_reads() {
+        let dir = std::env::temp_dir().join(format!("cosdem-field-legacy-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("field.json");
+        let text = serde_json::to_string(&triangle(3))
+            .unwrap()
+            .replace("\"gauss_points\":[3]", "\"gauss_per_element\":3");
+        assert!(text.contains("gauss_per_element"), "{text}");
+        std::fs::write(&path, text).unwrap();
+        assert_eq!(FieldData::read(&path).unwrap(), triangle(3));
         std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -467,8 +467,7 @@ impl RunWriter {
 
     fn write_vtk(&mut self, step: u64, time: f64, view: &SolutionView<'_>) -> Result<()> {
         let mesh = view.mesh;
-        let npe = mesh.kind.nodes();
-        let elements: Vec<Vec<usize>> = mesh.connectivity.chunks(npe).map(|c| c.to_vec()).collect();
+        let elements = mesh.element_lists();
         let dofs: Vec<[f64; 3]> = view
             .displacements()
             .iter()

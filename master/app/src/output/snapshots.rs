@@ -109,21 +109,22 @@ impl Material for SnapshotTap<'_> {
 }
 
 /// Checks the requested `[element, point]` pairs (the job's `output.snapshots`) against the
-/// Gauss points of the mesh.
+/// Gauss points of the mesh, `points[e]` in element `e`.
 pub fn resolve_snapshot_ids(
     requested: &[[u32; 2]],
-    n_elements: usize,
-    per_element: usize,
+    points: &[usize],
 ) -> cosdem_fem::Result<Vec<GaussPointId>> {
     let mut ids = Vec::new();
     for &[e, p] in requested {
-        if e as usize >= n_elements || p as usize >= per_element {
+        let count = points.get(e as usize).copied();
+        if count.is_none_or(|n| p as usize >= n) {
             return Err(cosdem_fem::Error::InvalidSetting {
                 field: "output.snapshots",
                 value: format!("[{e}, {p}]"),
-                reason: format!(
-                    "the mesh has elements 0..{n_elements} with points 0..{per_element}"
-                ),
+                reason: match count {
+                    None => format!("the mesh has elements 0..{}", points.len()),
+                    Some(n) => format!("element {e} has points 0..{n}"),
+                },
             });
         }
         let id = GaussPointId::new(e, p);
@@ -334,9 +335,14 @@ mod tests {
 
     #[test]
     fn snapshot_ids_are_checked() {
-        let ids = resolve_snapshot_ids(&[[0, 0], [3, 3], [0, 0]], 4, 4).unwrap();
+        let ids = resolve_snapshot_ids(&[[0, 0], [3, 3], [0, 0]], &[4; 4]).unwrap();
         assert_eq!(ids, vec![GaussPointId::new(0, 0), GaussPointId::new(3, 3)]);
-        let e = resolve_snapshot_ids(&[[4, 0]], 4, 4).unwrap_err().to_string();
+        let e = resolve_snapshot_ids(&[[4, 0]], &[4; 4]).unwrap_err().to_string();
         assert!(e.contains("output.snapshots") && e.contains("[4, 0]"), "{e}");
+        assert!(e.contains("elements 0..4"), "{e}");
+        // A mixed mesh: element 1 is a triangle of 3 points.
+        let e = resolve_snapshot_ids(&[[1, 3]], &[4, 3]).unwrap_err().to_string();
+        assert!(e.contains("element 1 has points 0..3"), "{e}");
+        assert!(resolve_snapshot_ids(&[[0, 3], [1, 2]], &[4, 3]).is_ok());
     }
 }

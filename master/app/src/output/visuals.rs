@@ -110,17 +110,18 @@ impl VisualOutputs {
 
     fn write_field(&self, dir: &Path, s: StepInfo, view: &SolutionView<'_>) -> Result<()> {
         let mesh = view.mesh;
-        let npe = mesh.kind.nodes();
-        let n_el = mesh.n_elements();
-        let per = view.gauss_points.len().checked_div(n_el).unwrap_or(0);
+        let mut gauss_points = vec![0; mesh.n_elements()];
+        for g in view.gauss_points {
+            gauss_points[g.id.element as usize] += 1;
+        }
         let data = FieldData {
             step: s.step,
             displacement: s.displacement,
             internal_length: s.internal_length,
             nodes: mesh.nodes.clone(),
             displacements: view.displacements(),
-            elements: mesh.connectivity.chunks(npe).map(|c| c.to_vec()).collect(),
-            gauss_per_element: per,
+            elements: mesh.element_lists(),
+            gauss_points,
             equivalent_strain: view
                 .gauss_points
                 .iter()

@@ -291,11 +291,7 @@ impl<'a> Run<'a> {
         let stages = job.stages()?;
         let ids = gauss_point_ids(&solver);
         let watched = if snapshots {
-            resolve_snapshot_ids(
-                &job.output.snapshots,
-                solver.model().mesh.n_elements(),
-                solver.gauss().per_element,
-            )?
+            resolve_snapshot_ids(&job.output.snapshots, &solver.gauss().counts())?
         } else {
             Vec::new()
         };

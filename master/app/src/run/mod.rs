@@ -178,10 +178,7 @@ pub fn run_settings(job: &Job) -> RunSettings {
 
 /// Every Gauss point of the solver's mesh, element-major.
 pub fn gauss_point_ids(solver: &Solver) -> Vec<GaussPointId> {
-    let per_element = solver.gauss().per_element as u32;
-    (0..solver.model().mesh.n_elements() as u32)
-        .flat_map(|e| (0..per_element).map(move |p| GaussPointId::new(e, p)))
-        .collect()
+    solver.gauss().ids()
 }
 
 /// Runs `job` into `dir` (created) and returns the final summary and curve: a plain

@@ -1,20 +1,27 @@
 //! Mapped shape functions at every Gauss point of the mesh, computed once.
 
-use crate::element::{Quadrature, QuadratureRule, shape_at};
+use crate::element::{ElementKind, Quadrature, QuadratureRule, shape_at};
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
 use cosdem_common::GaussPointId;
+use std::ops::Range;
 
 /// Shape functions, physical gradients, weights and positions of all Gauss points.
 ///
-/// Gauss point `g = element * per_element + point`.
+/// Points are numbered element by element: element `e` holds `points(e)`, in its rule's
+/// order. On a mesh of one kind every element holds as many; a mesh mixing triangles and
+/// quadrilaterals integrates each with its family's rule of the same role
+/// ([`QuadratureRule::on`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct GaussData {
-    /// Nodes per element.
-    pub nodes_per_element: usize,
-    /// Gauss points per element.
-    pub per_element: usize,
-    /// `N_a` at each point (`nodes_per_element` per point).
+    /// First point of each element, and the number of points last.
+    pub element_start: Vec<usize>,
+    /// Element of each point.
+    pub element: Vec<u32>,
+    /// Start of each point's entries in `n` and `grad` (as many as its element has nodes),
+    /// and their length last.
+    pub shape_start: Vec<usize>,
+    /// `N_a` at each point.
     pub n: Vec<f64>,
     /// `[dN_a/dx, dN_a/dy]` at each point.
     pub grad: Vec<[f64; 2]>,
@@ -25,43 +32,51 @@ pub struct GaussData {
 }
 
 impl GaussData {
-    /// Maps `rule` onto every element; fails on an inverted element, and on a rule that does
-    /// not fit the mesh's elements (a square rule on triangles or the reverse: see
+    /// Maps `rule` onto every element it fits and its counterpart ([`QuadratureRule::on`])
+    /// onto the others; fails on an inverted element, and on a rule that fits none of the
+    /// mesh's elements (a square rule on a mesh of triangles or the reverse: see
     /// [`QuadratureRule::for_kind`]).
     pub fn new(mesh: &Mesh, rule: QuadratureRule) -> Result<Self> {
-        if !rule.fits(mesh.kind) {
+        if !mesh.kinds.iter().any(|&k| rule.fits(k)) {
+            let kind = mesh.kinds[0];
             return Err(Error::InvalidSetting {
                 field: "rule",
                 value: format!("{rule:?}"),
                 reason: format!(
-                    "not a rule of {:?} elements; their reduced and full rules are {:?} and {:?}",
-                    mesh.kind,
-                    QuadratureRule::for_kind(mesh.kind, false),
-                    QuadratureRule::for_kind(mesh.kind, true)
+                    "not a rule of {kind:?} elements; their reduced and full rules are {:?} \
+                     and {:?}",
+                    QuadratureRule::for_kind(kind, false),
+                    QuadratureRule::for_kind(kind, true)
                 ),
             });
         }
-        let q = Quadrature::new(rule);
-        let nn = mesh.kind.nodes();
-        let total = mesh.n_elements() * q.len();
+        let (square, triangle) =
+            (Quadrature::new(rule.on(ElementKind::Q8)), Quadrature::new(rule.on(ElementKind::T6)));
         let mut data = Self {
-            nodes_per_element: nn,
-            per_element: q.len(),
-            n: Vec::with_capacity(total * nn),
-            grad: Vec::with_capacity(total * nn),
-            weight: Vec::with_capacity(total),
-            x: Vec::with_capacity(total),
+            element_start: Vec::with_capacity(mesh.n_elements() + 1),
+            element: Vec::new(),
+            shape_start: vec![0],
+            n: Vec::new(),
+            grad: Vec::new(),
+            weight: Vec::new(),
+            x: Vec::new(),
         };
         for e in 0..mesh.n_elements() {
+            let kind = mesh.element_kind(e);
+            let q = if kind.is_triangle() { &triangle } else { &square };
             let coords = mesh.element_coords(e);
+            data.element_start.push(data.weight.len());
             for (p, w) in q.points.iter().zip(&q.weights) {
-                let s = shape_at(mesh.kind, e, &coords, *p)?;
+                let s = shape_at(kind, e, &coords, *p)?;
                 data.n.extend_from_slice(&s.n);
                 data.grad.extend_from_slice(&s.grad);
+                data.shape_start.push(data.n.len());
                 data.weight.push(w * s.det_j);
                 data.x.push(s.x);
+                data.element.push(e as u32);
             }
         }
+        data.element_start.push(data.weight.len());
         Ok(data)
     }
 
@@ -75,18 +90,39 @@ impl GaussData {
         self.weight.is_empty()
     }
 
+    /// The points of element `e`.
+    pub fn points(&self, e: usize) -> Range<usize> {
+        self.element_start[e]..self.element_start[e + 1]
+    }
+
+    /// The number of points of each element.
+    pub fn counts(&self) -> Vec<usize> {
+        self.element_start.windows(2).map(|w| w[1] - w[0]).collect()
+    }
+
+    /// The element point `g` belongs to.
+    pub fn element_of(&self, g: usize) -> usize {
+        self.element[g] as usize
+    }
+
     /// Identity of Gauss point `g`.
     pub fn id(&self, g: usize) -> GaussPointId {
-        GaussPointId::new((g / self.per_element) as u32, (g % self.per_element) as u32)
+        let e = self.element_of(g);
+        GaussPointId::new(e as u32, (g - self.element_start[e]) as u32)
+    }
+
+    /// Every point's identity, in order.
+    pub fn ids(&self) -> Vec<GaussPointId> {
+        (0..self.len()).map(|g| self.id(g)).collect()
     }
 
     /// Shape values of point `g`.
     pub fn shape(&self, g: usize) -> &[f64] {
-        &self.n[g * self.nodes_per_element..(g + 1) * self.nodes_per_element]
+        &self.n[self.shape_start[g]..self.shape_start[g + 1]]
     }
 
     /// Shape gradients of point `g`.
     pub fn gradient(&self, g: usize) -> &[[f64; 2]] {
-        &self.grad[g * self.nodes_per_element..(g + 1) * self.nodes_per_element]
+        &self.grad[self.shape_start[g]..self.shape_start[g + 1]]
     }
 }

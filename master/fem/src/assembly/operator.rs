@@ -101,7 +101,7 @@ impl CosseratOperator {
         let ndf = self.field.ndf();
         (0..gauss.len())
             .map(|g| {
-                let el = mesh.element_nodes(g / gauss.per_element);
+                let el = mesh.element_nodes(gauss.element_of(g));
                 let (n, grad) = (gauss.shape(g), gauss.gradient(g));
                 let mut h = [[0.0; 2]; 2]; // du_a/dx_b
                 let (mut w, mut k) = (0.0, [0.0; 2]);
@@ -151,8 +151,6 @@ impl CosseratOperator {
         du_c: Option<&[f64]>,
     ) -> Assembled {
         let ndf = self.field.ndf();
-        let nn = gauss.nodes_per_element;
-        let nd = nn * ndf;
         let mut out = Assembled {
             f_int: vec![0.0; dofs.n_dofs()],
             k_fc_du: if du_c.is_some() { vec![0.0; dofs.n_free] } else { Vec::new() },
@@ -163,21 +161,23 @@ impl CosseratOperator {
         let want_k = values.is_some() || du_c.is_some();
         let mut b = [[0.0; MAX_ND]; 6];
         let mut cb = [[0.0; MAX_ND]; 6];
-        let mut ke = vec![0.0; nd * nd];
-        let mut gdof = vec![0usize; nd];
+        let mut ke = vec![0.0; MAX_ND * MAX_ND];
+        let mut gdof = vec![0usize; MAX_ND];
         let ul = self.kinematics == Kinematics::UpdatedLagrangian;
         let cauchy = self.field == Field::Cauchy;
         let mut gc = [[0.0; 2]; MAX_NODES];
         let mut dtheta = [[0.0; 2]; MAX_NODES];
         for e in 0..mesh.n_elements() {
             let el = mesh.element_nodes(e);
+            let nn = el.len();
+            let nd = nn * ndf;
             for (a, &node) in el.iter().enumerate() {
                 for c in 0..ndf {
                     gdof[a * ndf + c] = node * ndf + c;
                 }
             }
-            ke.fill(0.0);
-            for g in e * gauss.per_element..(e + 1) * gauss.per_element {
+            ke[..nd * nd].fill(0.0);
+            for g in gauss.points(e) {
                 let r = &responses[g];
                 let (n, grad_ref) = (gauss.shape(g), gauss.gradient(g));
                 let mut wt = gauss.weight[g];
@@ -303,7 +303,7 @@ mod tests {
                     let mut b = [[0.0; MAX_ND]; 6];
                     for g in 0..gauss.len() {
                         op.b_matrix(gauss.shape(g), gauss.gradient(g), &mut b);
-                        let el = mesh.element_nodes(g / gauss.per_element);
+                        let el = mesh.element_nodes(gauss.element_of(g));
                         let e = inputs[g].deformation.strain();
                         for s in 0..6 {
                             let be: f64 = el.iter().enumerate().flat_map(|(a, &n)| (0..ndf).map(move |c| (a, n, c)))

@@ -4,8 +4,9 @@
 //!
 //! A rule belongs to one reference element: [`QuadratureRule::fits`] tells whether it suits
 //! an element kind, and [`QuadratureRule::for_kind`] picks the reduced or full rule of a kind
-//! (what a job's `integration = "reduced" | "full"` means for that kind). The Gauss data of a
-//! mesh refuse a rule that does not fit the mesh's elements.
+//! (what a job's `integration = "reduced" | "full"` means for that kind), and
+//! [`QuadratureRule::on`] gives the rule of the same role on another reference element: a
+//! mesh mixing triangles and quadrilaterals integrates each family with its own rule.
 
 use super::ElementKind;
 
@@ -52,6 +53,23 @@ impl QuadratureRule {
     /// Whether the rule is defined on the reference element of `kind`.
     pub const fn fits(self, kind: ElementKind) -> bool {
         self.is_triangle() == kind.is_triangle()
+    }
+
+    /// The rule of the same role on the reference element of `kind`: itself when it fits,
+    /// otherwise its counterpart (reduced `Gauss2x2` / `Triangle3`, full `Gauss3x3` /
+    /// `Triangle6`, error norms `Gauss4x4` / `Triangle16`).
+    pub const fn on(self, kind: ElementKind) -> Self {
+        if self.fits(kind) {
+            return self;
+        }
+        match self {
+            Self::Gauss2x2 => Self::Triangle3,
+            Self::Gauss3x3 => Self::Triangle6,
+            Self::Gauss4x4 => Self::Triangle16,
+            Self::Triangle3 => Self::Gauss2x2,
+            Self::Triangle6 => Self::Gauss3x3,
+            Self::Triangle16 => Self::Gauss4x4,
+        }
     }
 
     /// The reduced (`full = false`) or full rule of an element kind: Q8 and Q9 `Gauss2x2` /
@@ -176,6 +194,22 @@ impl Quadrature {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `on` keeps a rule on its own element and swaps it for the counterpart of the same
+    /// role on the other: what integrates a mixed mesh with one `integration` setting.
+    #[test]
+    fn on_maps_each_rule_to_the_same_role() {
+        for full in [false, true] {
+            for kind in [ElementKind::Q8, ElementKind::Q9, ElementKind::T6] {
+                for from in [ElementKind::Q8, ElementKind::T6] {
+                    let rule = QuadratureRule::for_kind(from, full);
+                    assert_eq!(rule.on(kind), QuadratureRule::for_kind(kind, full));
+                }
+            }
+        }
+        assert_eq!(QuadratureRule::Gauss4x4.on(ElementKind::T6), QuadratureRule::Triangle16);
+        assert_eq!(QuadratureRule::Triangle16.on(ElementKind::Q9), QuadratureRule::Gauss4x4);
+    }
 
     /// Each rule integrates x^a y^b exactly up to degree 2n-1 per direction.
     #[test]

@@ -174,23 +174,6 @@ pub(super) fn assemble(
              quadrilaterals)",
         ));
     }
-    // One family per mesh, for now: the first element (smallest tag) sets it.
-    let mut families = quads.iter().map(|(&tag, q)| (tag, q.0, q.3));
-    if let Some((first, first_kind, _)) = families.next()
-        && let Some((other, other_kind, line)) =
-            families.find(|f| f.1.is_triangle() != first_kind.is_triangle())
-    {
-        let name = |k: SurfaceKind| type_info(k.gmsh_type()).map_or("?", |i| i.0);
-        return Err(GmshError::MixedElements {
-            file: file.to_string(),
-            line,
-            first,
-            first_name: name(first_kind),
-            other,
-            other_name: name(other_kind),
-        });
-    }
-
     // Renumber the used nodes by increasing tag.
     let mut used: BTreeSet<u64> = BTreeSet::new();
     for (_, nodes, _, _) in quads.values() {

@@ -1,4 +1,4 @@
-//! Gmsh `.msh` reader for meshes of 8- and 9-node quadrilaterals or 6-node triangles.
+//! Gmsh `.msh` reader for meshes of 8- and 9-node quadrilaterals and 6-node triangles.
 //!
 //! Reads the ASCII formats 2.2 (`gmsh -format msh22`) and 4.1 (`-format msh41`, Gmsh's
 //! default), and binary 4.1 (`-format msh41 -bin`), into a [`RawMesh`]: node coordinates,
@@ -8,9 +8,8 @@
 //! - 2D elements of Gmsh type 16 (8-node serendipity, [`SurfaceKind::Q8`]), type 10 (9-node
 //!   Lagrange, [`SurfaceKind::Q9`]) and type 9 (6-node triangle, [`SurfaceKind::T6`]). Any
 //!   other 2D or 3D element type is an error naming the type (a first-order 3-node triangle
-//!   or 4-node quadrangle with the hint to mesh with `Mesh.ElementOrder = 2`). A mesh of
-//!   triangles and quadrilaterals together is refused for now
-//!   ([`GmshError::MixedElements`]). Corner order is made counter-clockwise: an element whose
+//!   or 4-node quadrangle with the hint to mesh with `Mesh.ElementOrder = 2`). The kinds may
+//!   be mixed in one mesh (what Gmsh's recombination leaves). Corner order is made counter-clockwise: an element whose
 //!   corners turn clockwise is mirrored (quadrilaterals: corners `0 3 2 1`, mid-edge nodes
 //!   `7 6 5 4`, centre stays; triangles: corners `0 2 1`, mid-side nodes `5 4 3`).
 //! - 0D and 1D elements (points, 2- and 3-node lines) that belong to a physical group: their
@@ -39,7 +38,6 @@
 //! [`SurfaceKind::Q8`]: crate::gmsh::SurfaceKind::Q8
 //! [`SurfaceKind::Q9`]: crate::gmsh::SurfaceKind::Q9
 //! [`SurfaceKind::T6`]: crate::gmsh::SurfaceKind::T6
-//! [`GmshError::MixedElements`]: crate::gmsh::GmshError::MixedElements
 
 mod ascii;
 mod binary;
@@ -132,25 +130,6 @@ pub enum GmshError {
         /// What to do instead: for a first-order triangle or quadrangle, mesh with
         /// `Mesh.ElementOrder = 2`; otherwise the element types the solver takes.
         hint: &'static str,
-    },
-    /// Triangles and quadrilaterals in one mesh (not supported yet).
-    #[error(
-        "{file}:{line}: mixed meshes are not supported yet: element {first} is a \
-         {first_name}, element {other} a {other_name}"
-    )]
-    MixedElements {
-        /// The file.
-        file: String,
-        /// 1-based line of element `other`.
-        line: usize,
-        /// Gmsh tag of the first element of the mesh's first family.
-        first: u64,
-        /// Its Gmsh description (`6-node triangle`, ...).
-        first_name: &'static str,
-        /// Gmsh tag of the first element of the other family.
-        other: u64,
-        /// Its Gmsh description.
-        other_name: &'static str,
     },
     /// An element whose shape the solver cannot use: a mid-side node far off its edge or a
     /// non-positive Jacobian (see [`crate::element::shape_defect`]; triangles).

@@ -1,5 +1,6 @@
-//! The macro mesh: nodes, quadratic elements (8- and 9-node quadrilaterals, 6-node
-//! triangles; one kind per mesh for now) and named node, edge and element sets.
+//! The macro mesh: nodes, quadratic elements (8- and 9-node quadrilaterals and 6-node
+//! triangles, alone or mixed: their edges are all 3-node lines) and named node, edge and
+//! element sets.
 //!
 //! Every mesh, structured or read from a file, goes through [`Mesh::from_description`]: the
 //! Gmsh reader only has to fill a [`MeshDescription`].
@@ -21,7 +22,7 @@ pub struct MeshDescription {
     /// Node coordinates `[x, y]` (m).
     pub nodes: Vec<[f64; 2]>,
     /// Element node lists: 8 (Gmsh type 16), 9 (type 10) or 6 (type 9, triangle) nodes in
-    /// Gmsh order; all elements of one mesh have the same kind.
+    /// Gmsh order; the kinds may be mixed.
     pub elements: Vec<Vec<usize>>,
     /// Named node groups (Gmsh physical points or any node list).
     pub node_groups: BTreeMap<String, Vec<usize>>,
@@ -49,10 +50,13 @@ pub struct BoundaryEdge {
 pub struct Mesh {
     /// Node coordinates `[x, y]` (m).
     pub nodes: Vec<[f64; 2]>,
-    /// Element family (all elements alike).
-    pub kind: ElementKind,
-    /// Element node lists, `kind.nodes()` entries per element, Gmsh order, counter-clockwise.
+    /// Kind of each element.
+    pub kinds: Vec<ElementKind>,
+    /// Element node lists one after the other (`kinds[e].nodes()` entries for element `e`,
+    /// Gmsh order, counter-clockwise); element `e`'s are `offsets[e]..offsets[e + 1]`.
     pub connectivity: Vec<usize>,
+    /// Start of each element's nodes in `connectivity`, and its length last.
+    pub offsets: Vec<usize>,
     /// Named node sets (sorted, unique node indices).
     pub node_sets: BTreeMap<String, Vec<usize>>,
     /// Named boundary edge sets, for tractions.
@@ -69,10 +73,10 @@ fn invalid(field: &'static str, value: impl ToString, reason: impl ToString) -> 
 impl Mesh {
     /// Builds and checks a mesh from a raw description.
     ///
-    /// The element kind follows from the first element's node count (8: Q8, 9: Q9, 6: T6);
-    /// every element must have as many. Elements given clockwise (signed area of the corner
-    /// polygon) are renumbered counter-clockwise with [`ElementKind::flip`]; an element of
-    /// zero area is an error naming it. Triangles are also held to [`shape_defect`]
+    /// Each element's kind follows from its node count (8: Q8, 9: Q9, 6: T6). Elements given
+    /// clockwise (signed area of the corner polygon) are renumbered counter-clockwise with
+    /// [`ElementKind::flip`]; an element of zero area is an error naming it, and so is an edge
+    /// two elements share with different middle nodes (the field would not be continuous). Triangles are also held to [`shape_defect`]
     /// (mid-side nodes within a quarter of the edge length of the edge's midpoint, positive
     /// Jacobian at nodes and integration points), an error naming the element and the node;
     /// quadrilaterals are checked at their Gauss points when the Gauss data are built. Edge
@@ -82,7 +86,9 @@ impl Mesh {
     /// the group.
     pub fn from_description(desc: MeshDescription) -> Result<Self> {
         let MeshDescription { nodes, elements, node_groups, edge_groups, element_groups } = desc;
-        let first = elements.first().ok_or_else(|| invalid("elements", 0, "no elements"))?;
+        if elements.is_empty() {
+            return Err(invalid("elements", 0, "no elements"));
+        }
         if elements.len() > MAX_ELEMENTS {
             return Err(invalid(
                 "elements",
@@ -90,33 +96,29 @@ impl Mesh {
                 format!("more than MAX_ELEMENTS = {MAX_ELEMENTS} elements"),
             ));
         }
-        let kind = match first.len() {
-            8 => ElementKind::Q8,
-            9 => ElementKind::Q9,
-            6 => ElementKind::T6,
-            n => {
-                return Err(invalid(
-                    "elements[0].len()",
-                    n,
-                    "expected 8 (Q8), 9 (Q9) or 6 (T6) nodes",
-                ));
-            }
-        };
         for (i, p) in nodes.iter().enumerate() {
             if !(p[0].is_finite() && p[1].is_finite()) {
                 return Err(invalid("nodes", i, format!("non-finite coordinates {p:?}")));
             }
         }
-        let nn = kind.nodes();
-        let mut connectivity = Vec::with_capacity(elements.len() * nn);
+        let mut connectivity = Vec::with_capacity(elements.iter().map(Vec::len).sum());
+        let mut kinds = Vec::with_capacity(elements.len());
+        let mut offsets = Vec::with_capacity(elements.len() + 1);
         for (e, el) in elements.iter().enumerate() {
-            if el.len() != nn {
-                return Err(invalid(
-                    "elements",
-                    e,
-                    format!("{} nodes, mesh is {kind:?}", el.len()),
-                ));
-            }
+            let kind = match el.len() {
+                8 => ElementKind::Q8,
+                9 => ElementKind::Q9,
+                6 => ElementKind::T6,
+                n => {
+                    return Err(invalid(
+                        "elements",
+                        e,
+                        format!("{n} nodes; expected 8 (Q8), 9 (Q9) or 6 (T6)"),
+                    ));
+                }
+            };
+            kinds.push(kind);
+            offsets.push(connectivity.len());
             if let Some(&bad) = el.iter().find(|&&n| n >= nodes.len()) {
                 return Err(invalid("elements", e, format!("node {bad} >= {}", nodes.len())));
             }
@@ -141,14 +143,28 @@ impl Mesh {
                 }
             }
         }
+        offsets.push(connectivity.len());
+        let element_nodes = |e: usize| &connectivity[offsets[e]..offsets[e + 1]];
 
         // Edge lookup: sorted end pair -> (element, local edge).
         let mut owner: HashMap<(usize, usize), (usize, usize)> = HashMap::new();
         for e in 0..elements.len() {
-            let el = &connectivity[e * nn..(e + 1) * nn];
-            for (k, ed) in kind.edges().iter().enumerate() {
+            let el = element_nodes(e);
+            for (k, ed) in kinds[e].edges().iter().enumerate() {
                 let (a, b) = (el[ed[0]], el[ed[1]]);
-                owner.insert((a.min(b), a.max(b)), (e, k));
+                if let Some((other, j)) = owner.insert((a.min(b), a.max(b)), (e, k)) {
+                    let middle = element_nodes(other)[kinds[other].edges()[j][2]];
+                    if middle != el[ed[2]] {
+                        return Err(invalid(
+                            "elements",
+                            e,
+                            format!(
+                                "its edge {a}-{b} has middle node {}, element {other}'s has {middle}",
+                                el[ed[2]]
+                            ),
+                        ));
+                    }
+                }
             }
         }
         let mut node_sets: BTreeMap<String, Vec<usize>> = BTreeMap::new();
@@ -170,8 +186,8 @@ impl Mesh {
                 let &(e, k) = owner.get(&(a.min(b), a.max(b))).ok_or_else(|| {
                     invalid("edge_groups", &name, format!("edge {line:?} is no element edge"))
                 })?;
-                let ed = kind.edges()[k];
-                let el = &connectivity[e * nn..(e + 1) * nn];
+                let ed = kinds[e].edges()[k];
+                let el = element_nodes(e);
                 let oriented = [el[ed[0]], el[ed[1]], el[ed[2]]];
                 if oriented[2] != line[2] {
                     return Err(invalid(
@@ -202,12 +218,28 @@ impl Mesh {
             group.dedup();
             element_sets.insert(name, group);
         }
-        Ok(Self { nodes, kind, connectivity, node_sets, edge_sets, element_sets })
+        Ok(Self { nodes, kinds, connectivity, offsets, node_sets, edge_sets, element_sets })
     }
 
     /// Number of elements.
     pub fn n_elements(&self) -> usize {
-        self.connectivity.len() / self.kind.nodes()
+        self.kinds.len()
+    }
+
+    /// Kind of element `e`.
+    pub fn element_kind(&self, e: usize) -> ElementKind {
+        self.kinds[e]
+    }
+
+    /// The one kind of all elements, or `None` for a mesh that mixes kinds.
+    pub fn uniform_kind(&self) -> Option<ElementKind> {
+        let first = *self.kinds.first()?;
+        self.kinds.iter().all(|&k| k == first).then_some(first)
+    }
+
+    /// Node lists of all elements, one `Vec` each (Gmsh order): the form output files use.
+    pub fn element_lists(&self) -> Vec<Vec<usize>> {
+        (0..self.n_elements()).map(|e| self.element_nodes(e).to_vec()).collect()
     }
 
     /// Number of nodes.
@@ -217,8 +249,7 @@ impl Mesh {
 
     /// Node indices of element `e`, Gmsh order.
     pub fn element_nodes(&self, e: usize) -> &[usize] {
-        let nn = self.kind.nodes();
-        &self.connectivity[e * nn..(e + 1) * nn]
+        &self.connectivity[self.offsets[e]..self.offsets[e + 1]]
     }
 
     /// Node coordinates of element `e`, Gmsh order.

@@ -151,7 +151,7 @@ mod tests {
     fn triangle_rectangle_counts_and_sets() {
         let m = Mesh::rectangle(ElementKind::T6, 2.0, 1.0, 4, 2, [0.0, 0.0]).unwrap();
         let m9 = Mesh::rectangle(ElementKind::Q9, 2.0, 1.0, 4, 2, [0.0, 0.0]).unwrap();
-        assert_eq!(m.kind, ElementKind::T6);
+        assert_eq!(m.uniform_kind(), Some(ElementKind::T6));
         assert_eq!(m.n_elements(), 16);
         assert_eq!(m.n_nodes(), 9 * 5);
         assert_eq!(m.nodes, m9.nodes);

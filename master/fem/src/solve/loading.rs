@@ -297,7 +297,7 @@ impl Loading {
         if let Some(body) = &self.body {
             let (fc, fl) = ramp_factors(self.body_ramp);
             for g in 0..gauss.len() {
-                let element = g / gauss.per_element;
+                let element = gauss.element_of(g);
                 let f = (body.0)(element, gauss.x[g]);
                 let el = mesh.element_nodes(element);
                 for (a, &node) in el.iter().enumerate() {

@@ -5,7 +5,7 @@ pub mod panel;
 
 use cosdem_fem::assembly::{Component, Field};
 use cosdem_fem::element::{ElementKind, Quadrature, QuadratureRule, shape_at};
-use cosdem_fem::mesh::Mesh;
+use cosdem_fem::mesh::{Mesh, MeshDescription};
 use cosdem_fem::solve::{Dirichlet, Loading, SolutionView};
 
 /// The QuadratureRule of each element family in the tests: Q8 reduced 2x2 (the paper),
@@ -18,6 +18,11 @@ pub const ELEMENTS: [(ElementKind, QuadratureRule); 2] =
 pub const TRIANGLES: [(ElementKind, QuadratureRule); 2] =
     [(ElementKind::T6, QuadratureRule::Triangle3), (ElementKind::T6, QuadratureRule::Triangle6)];
 
+/// Mixed meshes: the quadrilateral of each row of [`ELEMENTS`] with 6-node triangles, and
+/// the rule given (the quadrilaterals'; the triangles take its counterpart, `Triangle3` or
+/// `Triangle6`).
+pub const MIXED: [(ElementKind, QuadratureRule); 2] = ELEMENTS;
+
 /// A unit square of 3x3 elements (cells split in two for triangles) whose interior corner
 /// nodes are moved by up to 20 % of the element size (deterministically); edges stay
 /// straight: mid-edge nodes at edge midpoints, Q9 centres at the bilinear centre. So the
@@ -26,10 +31,26 @@ pub const TRIANGLES: [(ElementKind, QuadratureRule); 2] =
 /// vertices are moved as the quadrilaterals' are (same shifts in the same order).
 pub fn distorted_square(kind: ElementKind) -> Mesh {
     let mut m = Mesh::rectangle(kind, 1.0, 1.0, 3, 3, [0.0, 0.0]).unwrap();
+    distort(&mut m);
+    m
+}
+
+/// [`distorted_square`] of a [`mixed_square`] of 3x3 cells: `quad` elements in the left
+/// column, pairs of triangles in the other two.
+pub fn distorted_mixed_square(quad: ElementKind) -> Mesh {
+    let mut m = mixed_square(quad, 3, 1);
+    distort(&mut m);
+    m
+}
+
+/// Moves the interior corner nodes of a unit-square mesh as [`distorted_square`] says and
+/// puts every mid-side node (and Q9 centre) back where a straight-sided element has it.
+pub fn distort(m: &mut Mesh) {
     let shifts = [[0.06, -0.04], [-0.05, 0.065], [0.045, 0.05], [-0.06, -0.03]];
     let mut k = 0;
-    let corners: std::collections::BTreeSet<usize> =
-        (0..m.n_elements()).flat_map(|e| m.element_nodes(e)[..kind.corners()].to_vec()).collect();
+    let corners: std::collections::BTreeSet<usize> = (0..m.n_elements())
+        .flat_map(|e| m.element_nodes(e)[..m.element_kind(e).corners()].to_vec())
+        .collect();
     for &n in &corners {
         let [x, y] = m.nodes[n];
         let interior = x > 1e-9 && x < 1.0 - 1e-9 && y > 1e-9 && y < 1.0 - 1e-9;
@@ -39,6 +60,7 @@ pub fn distorted_square(kind: ElementKind) -> Mesh {
         }
     }
     for e in 0..m.n_elements() {
+        let kind = m.element_kind(e);
         let el = m.element_nodes(e).to_vec();
         let c: Vec<[f64; 2]> = el[..kind.corners()].iter().map(|&n| m.nodes[n]).collect();
         let mid = |a: [f64; 2], b: [f64; 2]| [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0];
@@ -52,7 +74,51 @@ pub fn distorted_square(kind: ElementKind) -> Mesh {
             ];
         }
     }
-    m
+}
+
+/// A unit square of `n` x `n` cells: the first `quad_columns` columns of cells are `quad`
+/// elements (Q8 or Q9), the others pairs of 6-node triangles split as
+/// [`Mesh::rectangle`] splits them. Nodes no element uses (Q8 cell centres) are dropped,
+/// the others keep their order. Sets: the rectangle's node and edge sets, and the element
+/// sets `quadrilaterals` and `triangles`.
+pub fn mixed_square(quad: ElementKind, n: usize, quad_columns: usize) -> Mesh {
+    let q = Mesh::rectangle(ElementKind::Q9, 1.0, 1.0, n, n, [0.0, 0.0]).unwrap();
+    let t = Mesh::rectangle(ElementKind::T6, 1.0, 1.0, n, n, [0.0, 0.0]).unwrap();
+    assert_eq!(q.nodes, t.nodes);
+    let (mut elements, mut quads, mut triangles) = (Vec::new(), Vec::new(), Vec::new());
+    for c in 0..n * n {
+        if c % n < quad_columns {
+            quads.push(elements.len());
+            elements.push(q.element_nodes(c)[..quad.nodes()].to_vec());
+        } else {
+            for e in [2 * c, 2 * c + 1] {
+                triangles.push(elements.len());
+                elements.push(t.element_nodes(e).to_vec());
+            }
+        }
+    }
+    let used: std::collections::BTreeSet<usize> = elements.iter().flatten().copied().collect();
+    let mut index = vec![usize::MAX; q.n_nodes()];
+    for (i, &n) in used.iter().enumerate() {
+        index[n] = i;
+    }
+    let keep = |nodes: &[usize]| -> Vec<usize> {
+        nodes.iter().filter(|&&n| index[n] != usize::MAX).map(|&n| index[n]).collect()
+    };
+    let desc = MeshDescription {
+        nodes: used.iter().map(|&n| q.nodes[n]).collect(),
+        elements: elements.iter().map(|el| keep(el)).collect(),
+        node_groups: q.node_sets.iter().map(|(k, v)| (k.clone(), keep(v))).collect(),
+        edge_groups: q
+            .edge_sets
+            .iter()
+            .map(|(k, v)| (k.clone(), v.iter().map(|e| e.nodes.map(|n| index[n])).collect()))
+            .collect(),
+        element_groups: [("quadrilaterals".into(), quads), ("triangles".into(), triangles)]
+            .into_iter()
+            .collect(),
+    };
+    Mesh::from_description(desc).unwrap()
 }
 
 /// Every node on the boundary of the unit square gets the exact `(u_x, u_y, w)`.
@@ -94,7 +160,7 @@ pub fn fe_field(
     xi: [f64; 2],
 ) -> ([f64; 2], [[f64; 3]; 3], [[f64; 2]; 3]) {
     let mesh = view.mesh;
-    let s = shape_at(mesh.kind, e, &mesh.element_coords(e), xi).unwrap();
+    let s = shape_at(mesh.element_kind(e), e, &mesh.element_coords(e), xi).unwrap();
     let ndf = view.field.ndf();
     let mut val = [0.0; 3];
     let mut grad = [[0.0; 2]; 3];
@@ -115,14 +181,9 @@ pub fn integrate(
     view: &SolutionView<'_>,
     f: impl Fn([f64; 2], [f64; 3], [[f64; 2]; 3]) -> f64,
 ) -> f64 {
-    let rule = if view.mesh.kind.is_triangle() {
-        QuadratureRule::Triangle16
-    } else {
-        QuadratureRule::Gauss4x4
-    };
-    let q = Quadrature::new(rule);
     let mut sum = 0.0;
     for e in 0..view.mesh.n_elements() {
+        let q = Quadrature::new(QuadratureRule::Gauss4x4.on(view.mesh.element_kind(e)));
         for (p, w) in q.points.iter().zip(&q.weights) {
             let (x, vj, grad) = fe_field(view, e, *p);
             sum += w * vj[1][0] * f(x, vj[0], grad);

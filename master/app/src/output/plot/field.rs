@@ -110,14 +110,15 @@ fn extrapolation(kind: ElementKind, points: usize) -> Option<Vec<Vec<f64>>> {
 /// its Gauss values evaluated at the nodes ([`extrapolation`]: the usual extrapolation), then
 /// averaged over the elements sharing each node.
 pub fn nodal_values(f: &FieldData) -> Vec<f64> {
-    let per = f.gauss_per_element;
     let mut sum = vec![0.0; f.nodes.len()];
     let mut count = vec![0u32; f.nodes.len()];
     let mut matrices = std::collections::BTreeMap::new();
-    for (e, nodes) in f.elements.iter().enumerate() {
-        let q = &f.equivalent_strain[e * per..(e + 1) * per];
-        let m =
-            matrices.entry(nodes.len()).or_insert_with(|| extrapolation(kind_of(nodes.len()), per));
+    for (nodes, range) in f.elements.iter().zip(f.point_ranges()) {
+        let per = range.len();
+        let q = &f.equivalent_strain[range];
+        let m = matrices
+            .entry((nodes.len(), per))
+            .or_insert_with(|| extrapolation(kind_of(nodes.len()), per));
         let Some(m) = m else { continue };
         for (a, row) in m.iter().enumerate() {
             sum[nodes[a]] += row.iter().zip(q).map(|(w, v)| w * v).sum::<f64>();
@@ -370,8 +371,8 @@ mod tests {
             internal_length: 0.01,
             displacements: mesh.nodes.iter().map(|p| [0.0, -0.01 * p[1]]).collect(),
             nodes: mesh.nodes.clone(),
-            elements: mesh.connectivity.chunks(kind.nodes()).map(|c| c.to_vec()).collect(),
-            gauss_per_element: gauss.per_element,
+            elements: mesh.element_lists(),
+            gauss_points: gauss.counts(),
             equivalent_strain: gauss.x.iter().map(|&x| q(x)).collect(),
         }
     }
@@ -404,7 +405,7 @@ mod tests {
             linear(x) + 0.03 * x[0] * x[1] - 0.01 * x[1] * x[1]
         }
         let f = sample(ElementKind::T6, QuadratureRule::Triangle3, linear);
-        assert_eq!((f.gauss_per_element, f.elements.len()), (3, 8));
+        assert_eq!((f.gauss_points[0], f.elements.len()), (3, 8));
         assert!(nodal_error(&f, linear) < 1e-13, "{}", nodal_error(&f, linear));
         let m = extrapolation(ElementKind::T6, 3).unwrap();
         for (mid, [a, b]) in [(3, [0, 1]), (4, [1, 2]), (5, [2, 0])] {
@@ -414,7 +415,7 @@ mod tests {
         }
         for q in [linear as fn([f64; 2]) -> f64, quadratic] {
             let f = sample(ElementKind::T6, QuadratureRule::Triangle6, q);
-            assert_eq!(f.gauss_per_element, 6);
+            assert_eq!(f.gauss_points[0], 6);
             assert!(nodal_error(&f, q) < 1e-13, "{}", nodal_error(&f, q));
         }
     }
