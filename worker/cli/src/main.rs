@@ -69,6 +69,24 @@ fn bench_dem(quick: bool) -> Result<()> {
         let r = cosdem_dem::bench::rate(n, steps)?;
         println!("{:>6} discs {:>8} steps {:.3e} particle-steps/s", r.discs, r.steps, r.rate);
     }
+    // Where a step's time goes (issue 30): the same workload with the equilibrium ratio at the
+    // spec's check_every, timed by stage.
+    for n in [100usize, 400, 1600, 6400] {
+        let steps = (work / n as f64).max(200.0) as u64;
+        let s = cosdem_dem::bench::split(n, steps)?;
+        let total: f64 = s.seconds.iter().sum();
+        let pct = |k: usize| 100.0 * s.seconds[k] / total;
+        println!(
+            "{:>6} discs stage split: integration {:.1} %, broad phase {:.1} %, forces {:.1} %, \
+             criterion {:.1} % ({:.3e} particle-steps/s with the criterion)",
+            s.discs,
+            pct(0),
+            pct(1),
+            pct(2),
+            pct(3),
+            s.discs as f64 * s.steps as f64 / total
+        );
+    }
     // What a switched-off sub-model saves (issue 6, item 3b): the kernel is monomorphized on
     // "has rolling" (k_r > 0 or c_r > 0) and "has dashpots" (any c > 0).
     use cosdem_dem::spec::{ContactParams, NormalModel, RollingModel, TangentialModel};

@@ -3,6 +3,7 @@
 
 use crate::assembly::Assembly;
 use crate::error::Result;
+use crate::integrate::StageTimes;
 use crate::spec::{AssemblySpec, ContactParams, PackingSpec};
 use cosdem_common::MacroDeformation;
 use std::time::Instant;
@@ -45,23 +46,59 @@ pub fn rate(n: usize, steps: u64) -> Result<Rate> {
 /// As [`rate`] with the given contact law (what switching a sub-model off saves).
 pub fn rate_with(n: usize, steps: u64, contact: ContactParams) -> Result<Rate> {
     let mut a = hexagonal_with(n, contact)?;
-    let chunk = 500u64;
-    let mut e = 0.0;
-    let mut run = |a: &mut Assembly, count: u64| -> Result<u64> {
-        let mut done = 0;
-        while done < count {
-            e -= 5e-6;
-            let target = MacroDeformation::from_gradient([[0.0, 0.0], [0.0, e]], 0.0, [0.0; 2]);
-            done += a.run_steps(&target, chunk)?;
-            a.commit();
-        }
-        Ok(done)
-    };
-    run(&mut a, 10 * chunk)?; // warm caches, close the contacts
+    let mut strain = 0.0;
+    compress(&mut a, &mut strain, 10 * CHUNK, None)?; // warm caches, close the contacts
     let t0 = Instant::now();
-    let s = run(&mut a, steps)?;
+    let s = compress(&mut a, &mut strain, steps, None)?;
     let dt = t0.elapsed().as_secs_f64();
     Ok(Rate { discs: a.disc_count(), steps: s, rate: (a.disc_count() as f64 * s as f64) / dt })
+}
+
+/// Steps per chunk of the compression workload.
+const CHUNK: u64 = 500;
+
+/// The workload of [`rate`]: `steps` steps in chunks of [`CHUNK`], each an affine jump of
+/// `-5e-6` vertical strain (from `strain`, which it advances) then the chunk's steps, then a
+/// commit. With a clock the equilibrium ratio is also computed, at the spec's `check_every`.
+fn compress(
+    a: &mut Assembly,
+    strain: &mut f64,
+    steps: u64,
+    mut clock: Option<&mut StageTimes>,
+) -> Result<u64> {
+    let mut done = 0;
+    while done < steps {
+        *strain -= 5e-6;
+        let target = MacroDeformation::from_gradient([[0.0, 0.0], [0.0, *strain]], 0.0, [0.0; 2]);
+        done += a.run_steps_timed(&target, CHUNK, clock.as_deref_mut())?;
+        a.commit();
+    }
+    Ok(done)
+}
+
+/// Where a step's time goes: seconds per [`crate::integrate::Stage`] over `steps` steps of
+/// [`rate`]'s workload at about `n` discs, the equilibrium ratio computed every
+/// `check_every` steps as in a solve. The clock reads the time four times a step, which the
+/// stages' figures include (tens of nanoseconds a step).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Split {
+    /// Discs in the assembly.
+    pub discs: usize,
+    /// Steps run.
+    pub steps: u64,
+    /// Seconds per stage, in the order of [`crate::integrate::Stage`]: integration, broad
+    /// phase, forces, criterion.
+    pub seconds: [f64; 4],
+}
+
+/// Measures a [`Split`]: the compression of [`rate`] after the same warm-up, timed by stage.
+pub fn split(n: usize, steps: u64) -> Result<Split> {
+    let mut a = hexagonal(n)?;
+    let mut strain = 0.0;
+    compress(&mut a, &mut strain, 10 * CHUNK, None)?;
+    let mut clock = StageTimes::new();
+    let s = compress(&mut a, &mut strain, steps, Some(&mut clock))?;
+    Ok(Split { discs: a.disc_count(), steps: s, seconds: clock.seconds })
 }
 
 /// Full relaxation of the 0.0784 m^2 assembly (r = 5 mm) after a `1e-3` compressive strain

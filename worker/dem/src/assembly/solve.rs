@@ -218,6 +218,19 @@ impl Assembly {
     /// Runs exactly `steps` leapfrog steps towards `target` (no convergence test): the
     /// benchmark's workload. Returns the steps taken.
     pub fn run_steps(&mut self, target: &MacroDeformation, steps: u64) -> Result<u64> {
+        self.run_steps_timed(target, steps, None)
+    }
+
+    /// [`Assembly::run_steps`] with the equilibrium ratio computed at the spec's
+    /// `check_every` as in a solve (with a tolerance of 0, so never met), and the time of each
+    /// stage added to `clock`: where a relaxation's time goes. Without a clock the ratio is
+    /// not computed (the rate benchmark's workload).
+    pub fn run_steps_timed(
+        &mut self,
+        target: &MacroDeformation,
+        steps: u64,
+        clock: Option<&mut integrate::StageTimes>,
+    ) -> Result<u64> {
         target.validate()?;
         let mut st = self.committed.clone();
         self.predict(&mut st, target);
@@ -227,9 +240,14 @@ impl Assembly {
         let sys = self.system(&law, pen.as_ref(), target);
         let mut spec = self.spec.relaxation.clone();
         spec.max_steps = steps;
-        spec.check_every = u32::MAX;
-        let rep =
-            integrate::relax(&sys, &mut st.dynamics, &mut st.pairs, &mut work, &spec, self.dt, 0.0);
+        let (d, pairs, dt) = (&mut st.dynamics, &mut st.pairs, self.dt);
+        let rep = match clock {
+            None => {
+                spec.check_every = u32::MAX;
+                integrate::relax(&sys, d, pairs, &mut work, &spec, dt, 0.0)
+            }
+            Some(clock) => integrate::relax_timed(&sys, d, pairs, &mut work, &spec, dt, 0.0, clock),
+        };
         self.work = work;
         let rep = rep?;
         self.trial = Some(st);

@@ -232,7 +232,25 @@ pub fn relax(
     dt: f64,
     tol: f64,
 ) -> Result<RelaxReport> {
+    relax_timed(sys, d, pairs, work, spec, dt, tol, &mut NoClock)
+}
+
+/// [`relax`] with `clock` told when each stage of a step ends: the same arithmetic (a clock
+/// only reads the time), so the same result bit for bit.
+#[allow(clippy::too_many_arguments)]
+pub fn relax_timed(
+    sys: &System<'_>,
+    d: &mut Dynamics,
+    pairs: &mut PairList,
+    work: &mut Work,
+    spec: &RelaxationSpec,
+    dt: f64,
+    tol: f64,
+    clock: &mut impl StageClock,
+) -> Result<RelaxReport> {
+    clock.start();
     let mut sums = forces(sys, d, pairs, work, dt);
+    clock.lap(Stage::Forces);
     let ratio_of = |d: &Dynamics, pairs: &PairList, work: &Work, sums: ContactSums| -> f64 {
         match spec.criterion {
             Criterion::UnbalancedForce => unbalanced_ratio(sys, d, work, sums),
@@ -277,6 +295,7 @@ pub fn relax(
             if step >= spec.max_steps {
                 return Ok(RelaxReport { steps: step, ratio, converged: false });
             }
+            clock.lap(Stage::Criterion);
         }
         let lim2 = rebuild_limit2(sys);
         let (disp2, h) = match fire.as_mut() {
@@ -286,8 +305,77 @@ pub fn relax(
             }
             Some(f) => f.advance(d, work, sys.inv_m, sys.inv_i, &pairs.xb, &pairs.yb, lim2),
         };
+        clock.lap(Stage::Integration);
         maybe_rebuild(sys, d, pairs, disp2);
+        clock.lap(Stage::BroadPhase);
         sums = forces(sys, d, pairs, work, h);
+        clock.lap(Stage::Forces);
         step += 1;
+    }
+}
+
+/// The stages of a relaxation step.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stage {
+    /// The velocity and position update of the driver (Cundall or FIRE).
+    Integration = 0,
+    /// The check for a pair-list rebuild, and the rebuild when some disc moved more than half
+    /// the skin.
+    BroadPhase = 1,
+    /// The contact law over the pair list, and the penalty springs.
+    Forces = 2,
+    /// The equilibrium ratio, every `check_every` steps.
+    Criterion = 3,
+}
+
+/// Told by [`relax_timed`] when it starts and each time a stage ends.
+pub trait StageClock {
+    /// A relaxation starts: what came before is no stage's.
+    fn start(&mut self);
+    /// `stage` has just ended.
+    fn lap(&mut self, stage: Stage);
+}
+
+/// The clock of every solve: does nothing, and compiles to nothing.
+pub struct NoClock;
+
+impl StageClock for NoClock {
+    #[inline(always)]
+    fn start(&mut self) {}
+    #[inline(always)]
+    fn lap(&mut self, _: Stage) {}
+}
+
+/// Wall time spent in each [`Stage`], indexed by the stage: each lap adds the time since the
+/// previous lap (or since the relaxation started) to the stage that ended.
+#[derive(Clone, Copy, Debug)]
+pub struct StageTimes {
+    last: std::time::Instant,
+    /// Seconds per stage, in the order of [`Stage`].
+    pub seconds: [f64; 4],
+}
+
+impl StageTimes {
+    /// A clock starting now with nothing counted.
+    pub fn new() -> Self {
+        Self { last: std::time::Instant::now(), seconds: [0.0; 4] }
+    }
+}
+
+impl Default for StageTimes {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl StageClock for StageTimes {
+    fn start(&mut self) {
+        self.last = std::time::Instant::now();
+    }
+
+    fn lap(&mut self, stage: Stage) {
+        let now = std::time::Instant::now();
+        self.seconds[stage as usize] += (now - self.last).as_secs_f64();
+        self.last = now;
     }
 }
