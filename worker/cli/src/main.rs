@@ -120,6 +120,31 @@ fn bench_dem(quick: bool) -> Result<()> {
         let r = cosdem_dem::bench::rate_with(n, steps, law)?;
         println!("{:>6} discs {name}: {:.3e} particle-steps/s", r.discs, r.rate);
     }
+    // DEM steps per answer against the assembly's size (issue 30, item 1): the biaxial
+    // example's specimen at sides 0.05-0.4 m (about 100-6 700 discs).
+    let sides: &[f64] = if quick { &[0.05, 0.1] } else { &[0.05, 0.1, 0.2, 0.4] };
+    let runs = cosdem_dem::bench::relaxation_scaling(sides)?;
+    for r in &runs {
+        println!(
+            "biaxial load steps to 1 % ({} discs, random 2-3 mm, periodic, 100 kPa): {} \
+             relaxations, {} converged, {:.0} steps and {:.2} ms per relaxation",
+            r.discs,
+            r.count,
+            r.converged,
+            r.steps as f64 / r.count as f64,
+            1e3 * r.seconds / r.count as f64
+        );
+    }
+    let fit = |f: fn(&cosdem_dem::bench::Relaxation) -> f64| {
+        let pts: Vec<(f64, f64)> = runs.iter().map(|r| (r.discs as f64, f(r))).collect();
+        cosdem_dem::bench::power_law_exponent(&pts)
+    };
+    println!(
+        "relaxation cost ~ N^{:.2}, steps ~ N^{:.2} (least squares over {} sizes)",
+        fit(|r| r.seconds),
+        fit(|r| r.steps as f64),
+        runs.len()
+    );
     let (n, steps, conv, wall) = cosdem_dem::bench::relaxation()?;
     println!(
         "relaxation 0.0784 m^2 ({n} discs, e_yy = -1e-3): {steps} steps, converged {conv}, {wall:.3} s"

@@ -115,6 +115,80 @@ pub fn relaxation() -> Result<(usize, u64, bool, f64)> {
     Ok((a.disc_count(), r.diagnostics.steps, r.diagnostics.converged, t0.elapsed().as_secs_f64()))
 }
 
+/// The relaxations of one size in [`relaxation_scaling`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Relaxation {
+    /// Discs in the assembly.
+    pub discs: usize,
+    /// Relaxations (load steps).
+    pub count: usize,
+    /// Relaxation steps of all of them (all sub-steps).
+    pub steps: u64,
+    /// How many reached the tolerance.
+    pub converged: usize,
+    /// Wall seconds of all the solves.
+    pub seconds: f64,
+}
+
+/// Load steps of [`relaxation_scaling`].
+pub const SCALING_STEPS: usize = 10;
+
+/// The cost of a relaxation against the assembly's size: the biaxial example's specimen
+/// (random discs of radii 2-3 mm, seed 7, brought to 100 kPa, periodic cell, the default
+/// relaxation) at each side in `sides`, taken through [`SCALING_STEPS`] load steps as a Gauss
+/// point of that example sees them before its peak (each `e_xx = +4e-4`, `e_yy = -1e-3`,
+/// solved from the last committed state, then committed: to 1 % axial strain). Issue 30's
+/// measure of "DEM steps per answer" against N.
+pub fn relaxation_scaling(sides: &[f64]) -> Result<Vec<Relaxation>> {
+    let mut out = Vec::with_capacity(sides.len());
+    for &side in sides {
+        let spec = AssemblySpec {
+            packing: PackingSpec::Random {
+                r_min: 0.002,
+                r_max: 0.003,
+                radii: vec![],
+                side,
+                seed: 7,
+                confining_stress: 1e5,
+            },
+            boundary: crate::spec::BoundarySpec::Periodic,
+            ..Default::default()
+        };
+        let mut a = Assembly::new(&spec)?;
+        let mut run = Relaxation {
+            discs: a.disc_count(),
+            count: SCALING_STEPS,
+            steps: 0,
+            converged: 0,
+            seconds: 0.0,
+        };
+        for k in 1..=SCALING_STEPS {
+            let e = k as f64;
+            let target =
+                MacroDeformation::from_gradient([[4e-4 * e, 0.0], [0.0, -1e-3 * e]], 0.0, [0.0; 2]);
+            let t0 = Instant::now();
+            let r = a.solve(&target)?;
+            run.seconds += t0.elapsed().as_secs_f64();
+            run.steps += r.diagnostics.steps;
+            run.converged += usize::from(r.diagnostics.converged);
+            a.commit();
+        }
+        out.push(run);
+    }
+    Ok(out)
+}
+
+/// The least-squares exponent `b` of `y ~ x^b` through the points (at least two distinct
+/// `x`, all positive).
+pub fn power_law_exponent(points: &[(f64, f64)]) -> f64 {
+    let n = points.len() as f64;
+    let (lx, ly): (Vec<f64>, Vec<f64>) = points.iter().map(|(x, y)| (x.ln(), y.ln())).unzip();
+    let (mx, my) = (lx.iter().sum::<f64>() / n, ly.iter().sum::<f64>() / n);
+    let sxy: f64 = lx.iter().zip(&ly).map(|(x, y)| (x - mx) * (y - my)).sum();
+    let sxx: f64 = lx.iter().map(|x| (x - mx) * (x - mx)).sum();
+    sxy / sxx
+}
+
 /// Builds a random polydisperse packing (r in [4, 6] mm, 100 kPa, seed 1) of side `side`
 /// with the given boundary: returns (discs, wall seconds).
 pub fn random_build(side: f64, boundary: crate::spec::BoundarySpec) -> Result<(usize, f64)> {
@@ -133,4 +207,22 @@ pub fn random_build(side: f64, boundary: crate::spec::BoundarySpec) -> Result<(u
     let t0 = Instant::now();
     let a = Assembly::new(&spec)?;
     Ok((a.disc_count(), t0.elapsed().as_secs_f64()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The exponent of exact power laws comes back to round-off (1e-12), whatever the
+    /// prefactor and the spacing of the points.
+    #[test]
+    fn power_law_exponent_recovers_exact_laws() {
+        for b in [0.5, 1.0, 1.38, 2.0] {
+            let pts: Vec<(f64, f64)> = [105.0, 418.0, 1613.0, 6407.0]
+                .iter()
+                .map(|&x| (x, 3e-5 * f64::powf(x, b)))
+                .collect();
+            assert!((power_law_exponent(&pts) - b).abs() < 1e-12, "{b}");
+        }
+    }
 }
