@@ -8,17 +8,16 @@
 //! boundaries); and the patch test on that unstructured, curved-edged mesh, which is exact
 //! here for the reason given at [`patch_test_on_gmsh_mixed_meshes`].
 
-use cosdem_fem::assembly::{Component, Field};
+mod common;
+
+use common::{boundary_values_on, data};
+use cosdem_fem::assembly::Field;
 use cosdem_fem::element::{ElementKind, QuadratureRule};
 use cosdem_fem::gmsh::{RawMesh, SurfaceKind, read_msh};
 use cosdem_fem::material::ElasticCosserat;
 use cosdem_fem::mesh::{Mesh, MeshDescription};
-use cosdem_fem::solve::{Loading, Model, Solver, SolverSettings};
+use cosdem_fem::solve::{Model, Solver, SolverSettings};
 use std::collections::HashMap;
-
-fn data(name: &str) -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)
-}
 
 fn count(raw: &RawMesh, kind: SurfaceKind) -> usize {
     raw.elements.iter().filter(|e| e.kind == kind).count()
@@ -106,20 +105,7 @@ fn patch_test_on_gmsh_mixed_meshes() {
         for field in [Field::Cauchy, Field::Cosserat] {
             let mesh = Mesh::from_description(read_msh(&data(file)).unwrap().into()).unwrap();
             assert!(mesh.kinds.contains(&ElementKind::T6));
-            let value = exact;
-            let mut boundary: Vec<usize> =
-                SIDES.iter().flat_map(|s| mesh.node_set(s).unwrap().to_vec()).collect();
-            boundary.sort_unstable();
-            boundary.dedup();
-            let mut loading = Loading::default();
-            for &n in &boundary {
-                let v = value(mesh.nodes[n]);
-                loading.nodal_dirichlet.push((n, Component::Ux, v[0]));
-                loading.nodal_dirichlet.push((n, Component::Uy, v[1]));
-                if field == Field::Cosserat {
-                    loading.nodal_dirichlet.push((n, Component::W, v[2]));
-                }
-            }
+            let loading = boundary_values_on(&mesh, &SIDES, field, exact);
             let model = Model { mesh, field, rule, loading, kinematics: Default::default() };
             let settings = SolverSettings { steps: 1, ..Default::default() };
             let mut solver = Solver::new(model, settings).unwrap();
@@ -129,7 +115,7 @@ fn patch_test_on_gmsh_mixed_meshes() {
             let ndf = field.ndf();
             let mut worst = 0.0f64;
             for (n, p) in view.mesh.nodes.iter().enumerate() {
-                let v = value(*p);
+                let v = exact(*p);
                 for c in 0..ndf {
                     worst = worst.max((view.dofs[n * ndf + c] - v[c]).abs());
                 }

@@ -99,8 +99,6 @@ pub const KINDS: [ElementKind; 3] = [ElementKind::Q8, ElementKind::Q9, ElementKi
 /// The size of the mesh: what the estimate needs of it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MeshCounts {
-    /// Elements.
-    pub elements: f64,
     /// Nodes.
     pub nodes: f64,
     /// Elements of each of [`KINDS`]: the kind sets the element's nodes and Gauss points
@@ -123,19 +121,22 @@ impl MeshCounts {
         // Q8 lacks the cells' centres; Q9 has every node of the (2 nx + 1) x (2 ny + 1) grid;
         // T6 too (a cell's diagonal has its mid-side at the centre), in two triangles a cell.
         let (elements, nodes, kind) = match m.element {
-            ElementChoice::Q8 => (nx * ny, grid - nx * ny, 0),
-            ElementChoice::Q9 => (nx * ny, grid, 1),
-            ElementChoice::T6 => (2.0 * nx * ny, grid, 2),
+            ElementChoice::Q8 => (nx * ny, grid - nx * ny, ElementKind::Q8),
+            ElementChoice::Q9 => (nx * ny, grid, ElementKind::Q9),
+            ElementChoice::T6 => (2.0 * nx * ny, grid, ElementKind::T6),
         };
-        let mut by_kind = [0.0; 3];
-        by_kind[kind] = elements;
-        Some(Self { elements, nodes, by_kind })
+        Some(Self { nodes, by_kind: KINDS.map(|k| if k == kind { elements } else { 0.0 }) })
     }
 
     /// The counts of a built mesh.
     pub fn of_mesh(mesh: &Mesh) -> Self {
         let by_kind = KINDS.map(|k| mesh.kinds.iter().filter(|&&e| e == k).count() as f64);
-        Self { elements: mesh.n_elements() as f64, nodes: mesh.n_nodes() as f64, by_kind }
+        Self { nodes: mesh.n_nodes() as f64, by_kind }
+    }
+
+    /// Elements, of every kind.
+    pub fn elements(&self) -> f64 {
+        self.by_kind.iter().sum()
     }
 
     /// Gauss points under `integration`: each element has those of the rule the solver gives
@@ -308,17 +309,16 @@ pub fn estimate(job: &Job, mesh: MeshCounts) -> Estimate {
     let scale = |k: ElementKind| {
         ((k.nodes() as f64 * dofs) / 24.0).powi(2).max(points_of(k, job.mesh.integration) / 4.0)
     };
-    let per_element = (FE_BYTES_PER_ELEMENT
-        + FE_BYTES_PER_ELEMENT_LOG2 * mesh.elements.max(1.0).log2())
+    let elements = mesh.elements();
+    let per_element = (FE_BYTES_PER_ELEMENT + FE_BYTES_PER_ELEMENT_LOG2 * elements.max(1.0).log2())
         * mesh.sum(scale)
-        / mesh.elements.max(1.0);
+        / elements.max(1.0);
     parts.push(Part {
         name: "mesh and linear system",
-        bytes: FE_WORKSPACE_BYTES + mesh.elements * per_element,
+        bytes: FE_WORKSPACE_BYTES + elements * per_element,
         in_process_only: false,
         detail: format!(
-            "{} elements x {} + {} solver workspace",
-            mesh.elements,
+            "{elements} elements x {} + {} solver workspace",
             size(per_element),
             size(FE_WORKSPACE_BYTES)
         ),

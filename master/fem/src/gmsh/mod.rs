@@ -9,9 +9,10 @@
 //!   Lagrange, [`SurfaceKind::Q9`]) and type 9 (6-node triangle, [`SurfaceKind::T6`]). Any
 //!   other 2D or 3D element type is an error naming the type (a first-order 3-node triangle
 //!   or 4-node quadrangle with the hint to mesh with `Mesh.ElementOrder = 2`). The kinds may
-//!   be mixed in one mesh (what Gmsh's recombination leaves). Corner order is made counter-clockwise: an element whose
-//!   corners turn clockwise is mirrored (quadrilaterals: corners `0 3 2 1`, mid-edge nodes
-//!   `7 6 5 4`, centre stays; triangles: corners `0 2 1`, mid-side nodes `5 4 3`).
+//!   be mixed in one mesh (what Gmsh's recombination leaves). Corner order is made
+//!   counter-clockwise: an element whose corners turn clockwise is mirrored (quadrilaterals:
+//!   corners `0 3 2 1`, mid-edge nodes `7 6 5 4`, centre stays; triangles: corners `0 2 1`,
+//!   mid-side nodes `5 4 3`).
 //! - 0D and 1D elements (points, 2- and 3-node lines) that belong to a physical group: their
 //!   nodes form [`RawMesh::node_groups`], and 3-node lines form [`RawMesh::edge_groups`].
 //!   Points and lines without a physical group are ignored.

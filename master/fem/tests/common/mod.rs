@@ -18,6 +18,11 @@ pub const ELEMENTS: [(ElementKind, QuadratureRule); 2] =
 pub const TRIANGLES: [(ElementKind, QuadratureRule); 2] =
     [(ElementKind::T6, QuadratureRule::Triangle3), (ElementKind::T6, QuadratureRule::Triangle6)];
 
+/// A file of `tests/data/`.
+pub fn data(name: &str) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data").join(name)
+}
+
 /// Mixed meshes: the quadrilateral of each row of [`ELEMENTS`] with 6-node triangles, and
 /// the rule given (the quadrilaterals'; the triangles take its counterpart, `Triangle3` or
 /// `Triangle6`).
@@ -123,11 +128,19 @@ pub fn mixed_square(quad: ElementKind, n: usize, quad_columns: usize) -> Mesh {
 
 /// Every node on the boundary of the unit square gets the exact `(u_x, u_y, w)`.
 pub fn boundary_values(mesh: &Mesh, field: Field, exact: impl Fn([f64; 2]) -> [f64; 3]) -> Loading {
+    boundary_values_on(mesh, &["bottom", "top", "left", "right"], field, exact)
+}
+
+/// Every node of the node sets `sides` gets the exact `(u_x, u_y, w)` (`w` for Cosserat only).
+pub fn boundary_values_on(
+    mesh: &Mesh,
+    sides: &[&str],
+    field: Field,
+    exact: impl Fn([f64; 2]) -> [f64; 3],
+) -> Loading {
     let mut loading = Loading::default();
-    let mut boundary: Vec<usize> = ["bottom", "top", "left", "right"]
-        .iter()
-        .flat_map(|s| mesh.node_set(s).unwrap().to_vec())
-        .collect();
+    let mut boundary: Vec<usize> =
+        sides.iter().flat_map(|s| mesh.node_set(s).unwrap().to_vec()).collect();
     boundary.sort_unstable();
     boundary.dedup();
     for n in boundary {

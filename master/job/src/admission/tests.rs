@@ -149,7 +149,7 @@ fn a_t6_rectangle_counts_three_points_per_triangle() {
         .replace("element = \"q8\"", "element = \"t6\"");
     let t6 = job(&text);
     let counts = MeshCounts::of_job(&t6).unwrap();
-    assert_eq!((counts.elements, counts.nodes, counts.by_kind), (8.0, 25.0, [0.0, 0.0, 8.0]));
+    assert_eq!((counts.elements(), counts.nodes, counts.by_kind), (8.0, 25.0, [0.0, 0.0, 8.0]));
     assert_eq!(counts, MeshCounts::of_mesh(&t6.build_mesh().unwrap()));
     let e = of(&t6);
     assert_eq!(e.gauss_points, 24.0);
