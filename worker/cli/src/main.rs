@@ -87,6 +87,19 @@ fn bench_dem(quick: bool) -> Result<()> {
             s.discs as f64 * s.steps as f64 / total
         );
     }
+    // The force kernel alone, per pair (issue 30, item 2).
+    for n in [1600usize, 6400] {
+        let passes = if quick { 20 } else { 1000 };
+        let (pairs, lanes) = cosdem_dem::bench::pair_cost(n, passes, false)?;
+        let (_, one) = cosdem_dem::bench::pair_cost(n, passes, true)?;
+        println!(
+            "{pairs:>6} pairs force kernel alone: {:.2} ns per pair four at a time, {:.2} ns one \
+             at a time ({:.2}x)",
+            lanes * 1e9,
+            one * 1e9,
+            one / lanes
+        );
+    }
     // What a switched-off sub-model saves (issue 6, item 3b): the kernel is monomorphized on
     // "has rolling" (k_r > 0 or c_r > 0) and "has dashpots" (any c > 0).
     use cosdem_dem::spec::{ContactParams, NormalModel, RollingModel, TangentialModel};

@@ -101,6 +101,34 @@ pub fn split(n: usize, steps: u64) -> Result<Split> {
     Ok(Split { discs: a.disc_count(), steps: s, seconds: clock.seconds })
 }
 
+/// The force kernel alone: the hexagonal assembly of about `n` discs after [`rate`]'s warm-up
+/// (every neighbour pair in contact), its forces computed `passes` times from the same state
+/// (the histories advance, nothing moves), by the kernel of every solve or, with `one_at_a_time`,
+/// by [`crate::contact::kernel::accumulate_scalar`]. Returns (pairs, seconds per pair).
+pub fn pair_cost(n: usize, passes: usize, one_at_a_time: bool) -> Result<(usize, f64)> {
+    use crate::contact::kernel::{Accum, Bodies, accumulate, accumulate_scalar};
+    let mut a = hexagonal(n)?;
+    let mut strain = 0.0;
+    compress(&mut a, &mut strain, 10 * CHUNK, None)?;
+    let (law, state) = (*a.law(), a.committed().clone());
+    let d = &state.dynamics;
+    let b = Bodies { x: &d.x, y: &d.y, vx: &d.vx, vy: &d.vy, w: &d.w, r: &a.reference().r };
+    let mut pairs = state.pairs.clone();
+    let m = a.disc_count();
+    let (mut fx, mut fy, mut tq) = (vec![0.0; m], vec![0.0; m], vec![0.0; m]);
+    let t0 = Instant::now();
+    for _ in 0..passes {
+        for f in [&mut fx, &mut fy, &mut tq] {
+            f.fill(0.0);
+        }
+        let mut acc = Accum { fx: &mut fx, fy: &mut fy, tq: &mut tq };
+        let kernel = if one_at_a_time { accumulate_scalar } else { accumulate };
+        std::hint::black_box(kernel(&law, a.time_step(), b, &mut pairs, &mut acc));
+    }
+    let per = t0.elapsed().as_secs_f64() / (passes.max(1) * pairs.len().max(1)) as f64;
+    Ok((pairs.len(), per))
+}
+
 /// Full relaxation of the 0.0784 m^2 assembly (r = 5 mm) after a `1e-3` compressive strain
 /// increment: returns (discs, steps, converged, wall seconds).
 pub fn relaxation() -> Result<(usize, u64, bool, f64)> {

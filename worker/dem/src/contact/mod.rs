@@ -9,12 +9,17 @@
 
 /// Force kernel over a pair list (the hot loop).
 pub mod kernel;
+/// The law's arithmetic for one pair and for four at once.
+pub mod lanes;
 /// Normal sub-model: spring-dashpot without tension.
 pub mod normal;
 /// One pair of discs, as a pure function (the reference the kernel is tested against).
 pub mod pair;
 /// Rolling sub-model: incremental spring with cap `mu_r r* F_n`.
 pub mod rolling;
+/// The force kernel four pairs at a time on AVX2.
+#[cfg(target_arch = "x86_64")]
+pub mod simd;
 /// Tangential sub-model: incremental spring with Coulomb cap.
 pub mod tangential;
 

@@ -10,6 +10,7 @@
 //! the contact work-conjugate (energy is conserved) and makes a rigid rotation slip-free.
 //! The difference from the printed formula is O(d/r).
 
+use super::lanes::Real;
 use super::{Law, normal, rolling, tangential};
 
 /// What one contact does to its two discs (force on `q`; `p` gets the opposite).
@@ -59,30 +60,126 @@ pub fn interact<const ROLL: bool, const DAMP: bool>(
     if d2 >= rs * rs {
         return None;
     }
+    let g = geometry::<f64, ROLL>(dx, dy, rp, rq, d2);
+    let c = respond::<f64, ROLL, DAMP>(law, dt, &g, Motion { dvx, dvy, wp, wq }, hs, hr);
+    Some(PairForce {
+        fx: c.fx,
+        fy: c.fy,
+        tp: c.tp,
+        tq: c.tq,
+        fnorm: c.fnorm,
+        fs: c.fs,
+        mr: c.mr,
+        hs: c.hs,
+        hr: c.hr,
+    })
+}
+
+/// The contact geometry of an overlapping pair, for one pair (`f64`) or four
+/// ([`super::lanes::F4`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Geometry<R> {
+    /// Unit normal from `p` to `q`, x.
+    pub nx: R,
+    /// Unit normal, y.
+    pub ny: R,
+    /// Overlap `r_p + r_q - d` (m).
+    pub ov: R,
+    /// Lever of `p`, `r_p - ov/2` (m).
+    pub ap: R,
+    /// Lever of `q` (m).
+    pub aq: R,
+    /// Rolling radius `r*` (zero without rolling).
+    pub rstar: R,
+}
+
+/// The geometry of a pair with branch `(dx, dy)`, radii `rp`, `rq` and `d2 = dx^2 + dy^2`
+/// (as `dx.mul_add(dx, dy * dy)`) below `(rp + rq)^2`. It holds the law's square root and
+/// divisions, apart from the rest so a kernel can run it over many pairs in a row.
+#[inline(always)]
+pub fn geometry<R: Real, const ROLL: bool>(dx: R, dy: R, rp: R, rq: R, d2: R) -> Geometry<R> {
+    let rs = rp + rq;
     let dist = d2.sqrt();
-    let inv = 1.0 / dist;
-    let nx = dx * inv;
-    let ny = dy * inv;
+    let inv = R::splat(1.0) / dist;
     let ov = rs - dist;
-    let ap = (-0.5f64).mul_add(ov, rp);
-    let aq = (-0.5f64).mul_add(ov, rq);
+    let half = R::splat(-0.5);
+    let rstar = if ROLL { rolling::rstar(rp, rq) } else { R::splat(0.0) };
+    Geometry {
+        nx: dx * inv,
+        ny: dy * inv,
+        ov,
+        ap: half.mul_add(ov, rp),
+        aq: half.mul_add(ov, rq),
+        rstar,
+    }
+}
+
+/// The relative motion of a pair: `v_q - v_p` and the two spins.
+#[derive(Clone, Copy, Debug)]
+pub struct Motion<R> {
+    /// Relative velocity `v_q - v_p`, x (m/s).
+    pub dvx: R,
+    /// Relative velocity, y (m/s).
+    pub dvy: R,
+    /// Spin of `p` (rad/s).
+    pub wp: R,
+    /// Spin of `q` (rad/s).
+    pub wq: R,
+}
+
+/// [`PairForce`] at either width.
+#[derive(Clone, Copy, Debug)]
+pub struct Response<R> {
+    /// Force on `q`, x (N).
+    pub fx: R,
+    /// Force on `q`, y (N).
+    pub fy: R,
+    /// Torque on `p` (N m).
+    pub tp: R,
+    /// Torque on `q` (N m).
+    pub tq: R,
+    /// Normal force magnitude (N).
+    pub fnorm: R,
+    /// Tangential force (N).
+    pub fs: R,
+    /// Rolling moment on `q` (N m).
+    pub mr: R,
+    /// New tangential history.
+    pub hs: R,
+    /// New rolling history.
+    pub hr: R,
+}
+
+/// The law of an overlapping pair (Eqs. 13-23 with the levers of the module documentation)
+/// from its [`geometry`], its motion and its histories. The scalar [`interact`] and the
+/// four-lane kernel both call [`geometry`] then this, so a pair gets the same bits in either.
+#[inline(always)]
+pub fn respond<R: Real, const ROLL: bool, const DAMP: bool>(
+    law: &Law,
+    dt: f64,
+    g: &Geometry<R>,
+    m: Motion<R>,
+    hs: R,
+    hr: R,
+) -> Response<R> {
+    let Geometry { nx, ny, ov, ap, aq, rstar } = *g;
+    let Motion { dvx, dvy, wp, wq } = m;
     // t = (-n_y, n_x)
     let vt = dvy.mul_add(nx, -(dvx * ny));
     let vs = vt - wp.mul_add(ap, wq * aq);
-    let d_dot = if DAMP { -dvx.mul_add(nx, dvy * ny) } else { 0.0 };
-    let fnorm = normal::force(law.kn, law.cn, ov, d_dot, DAMP);
+    let d_dot = if DAMP { -dvx.mul_add(nx, dvy * ny) } else { R::splat(0.0) };
+    let fnorm = normal::force(R::splat(law.kn), R::splat(law.cn), ov, d_dot, DAMP);
     let (fs, hs) = tangential::update(hs, law.ks, law.cs, law.mu_s, fnorm, vs, dt, DAMP);
     let (mr, hr) = if ROLL {
-        let rstar = rolling::rstar(rp, rq);
         rolling::update(hr, law.kr, law.cr, law.mu_r, rstar, fnorm, wq - wp, dt, DAMP)
     } else {
-        (0.0, 0.0)
+        (R::splat(0.0), R::splat(0.0))
     };
     let fx = fnorm.mul_add(nx, -(fs * ny));
     let fy = fnorm.mul_add(ny, fs * nx);
     let tq = (-aq).mul_add(fs, mr);
     let tp = (-ap).mul_add(fs, -mr);
-    Some(PairForce { fx, fy, tp, tq, fnorm, fs, mr, hs, hr })
+    Response { fx, fy, tp, tq, fnorm, fs, mr, hs, hr }
 }
 
 /// Convenience wrapper choosing the monomorphization from the law (tests, tools).

@@ -1,25 +1,27 @@
+use super::lanes::Real;
+
 /// Tangential update (Eqs. 16-19): history `f_s <- f_s - k_s v_s dt`, trial
 /// `F_s = f_s - c_s v_s`; above `mu_s F_n` the force is capped and the history set to it.
 ///
 /// Returns `(F_s, new history)`. Branch-free (`max`/`min`, never `clamp`, which would panic on
 /// a NaN from a diverging run instead of reporting it).
 #[inline(always)]
-pub fn update(
-    hist: f64,
+pub fn update<R: Real>(
+    hist: R,
     ks: f64,
     cs: f64,
     mu_s: f64,
-    fnorm: f64,
-    vs: f64,
+    fnorm: R,
+    vs: R,
     dt: f64,
     damped: bool,
-) -> (f64, f64) {
-    let h = (-ks * dt).mul_add(vs, hist);
-    let cap = mu_s * fnorm;
+) -> (R, R) {
+    let h = R::splat(-ks * dt).mul_add(vs, hist);
+    let cap = R::splat(mu_s) * fnorm;
     if damped {
-        let trial = (-cs).mul_add(vs, h);
+        let trial = R::splat(-cs).mul_add(vs, h);
         let capped = trial.max(-cap).min(cap);
-        let h = if trial.abs() > cap { capped } else { h };
+        let h = R::select(trial.abs().gt(cap), capped, h);
         (capped, h)
     } else {
         let capped = h.max(-cap).min(cap);
