@@ -5,6 +5,7 @@ use super::current::{
     Kinematics, PolarRotation, add_geometric_stiffness, current_gradients, deformation_gradient,
     det, polar_angle_derivative,
 };
+use super::pattern::NOT_FREE;
 use super::{DofMap, Field, GaussData, Pattern};
 use crate::material::MaterialInput;
 use crate::mesh::Mesh;
@@ -247,19 +248,20 @@ impl CosseratOperator {
             if !want_k {
                 continue;
             }
+            let at = pattern.element_scatter(e);
             for i in 0..nd {
                 let ri = dofs.equation[gdof[i]];
                 if ri == usize::MAX {
                     continue;
                 }
                 for j in 0..nd {
-                    let cj = dofs.equation[gdof[j]];
-                    if cj == usize::MAX {
+                    let k = at[i * nd + j];
+                    if k == NOT_FREE {
                         if let Some(du) = du_c {
                             out.k_fc_du[ri] += ke[i * nd + j] * du[gdof[j]];
                         }
                     } else if let Some(v) = values.as_deref_mut() {
-                        v[pattern.position(ri, cj)] += ke[i * nd + j];
+                        v[k as usize] += ke[i * nd + j];
                     }
                 }
             }

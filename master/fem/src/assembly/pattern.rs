@@ -12,7 +12,17 @@ pub struct Pattern {
     pub col_ptr: Vec<usize>,
     /// Row index of each stored entry, sorted within each column.
     pub row_idx: Vec<usize>,
+    /// Where each element's tangent goes: for element `e`, from `scatter_start[e]`, the
+    /// position in the value array of its entry `(i, j)` (element dofs, row-major), or
+    /// [`NOT_FREE`] where the row or the column is prescribed. Looked up once here, so an
+    /// assembly does not search the columns again (the search was about a third of it).
+    pub scatter: Vec<u32>,
+    /// Start of each element's entries in `scatter` (length `n_elements + 1`).
+    pub scatter_start: Vec<usize>,
 }
+
+/// A `scatter` entry whose row or column is a prescribed dof.
+pub const NOT_FREE: u32 = u32::MAX;
 
 impl Pattern {
     /// Couples every pair of free dofs that share an element.
@@ -50,7 +60,34 @@ impl Pattern {
             }
             col_ptr.push(row_idx.len());
         }
-        Self { n, col_ptr, row_idx }
+        let mut pattern = Self { n, col_ptr, row_idx, scatter: Vec::new(), scatter_start: vec![0] };
+        let mut eqs = Vec::new();
+        for e in 0..mesh.n_elements() {
+            eqs.clear();
+            for &a in mesh.element_nodes(e) {
+                eqs.extend((0..ndf).map(|c| dofs.equation[a * ndf + c]));
+            }
+            for &ri in &eqs {
+                for &cj in &eqs {
+                    let free = ri != usize::MAX && cj != usize::MAX;
+                    let at = if free { pattern.position(ri, cj) } else { usize::MAX };
+                    pattern.scatter.push(u32::try_from(at).unwrap_or(NOT_FREE));
+                }
+            }
+            pattern.scatter_start.push(pattern.scatter.len());
+        }
+        assert!(
+            pattern.nnz() < NOT_FREE as usize,
+            "a tangent of {} entries does not fit 32-bit positions",
+            pattern.nnz()
+        );
+        pattern
+    }
+
+    /// Element `e`'s positions (see [`Pattern::scatter`]).
+    #[inline]
+    pub fn element_scatter(&self, e: usize) -> &[u32] {
+        &self.scatter[self.scatter_start[e]..self.scatter_start[e + 1]]
     }
 
     /// Number of stored entries.

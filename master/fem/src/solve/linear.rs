@@ -1,12 +1,19 @@
 //! Sparse direct solves with faer: the symbolic factorization is computed once per pattern
 //! and reused for every Newton iteration and load step.
+//!
+//! The factorizations and solves run on one thread ([`Par::Seq`]). faer's default spreads them
+//! over every core with rayon, which on the 2-core machine made one Newton iteration's
+//! factorization and solve slower, not faster: 54.9 ms against 35.5 ms on one thread for the
+//! 43 x 43 Q8 panel (16 812 dofs), 671 ms against 583 ms at 100 x 100 (90 399 dofs)
+//! (`benches/newton_iteration.rs` in `cosdem-study`, 2026-12-06). One thread also makes the
+//! FE solution independent of the thread count by construction.
 
 use crate::assembly::Pattern;
 use crate::error::{Error, Result};
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::{Llt, Lu, SymbolicLlt, SymbolicLu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
-use faer::{MatMut, Side};
+use faer::{MatMut, Par, Side};
 
 /// A sparse direct solver bound to one sparsity pattern.
 #[derive(Debug)]
@@ -43,6 +50,7 @@ impl LinearSolver {
         if rhs.is_empty() {
             return Ok(());
         }
+        faer::set_global_parallelism(Par::Seq);
         let k = SparseColMatRef::new(self.symbolic.as_ref(), values);
         let n = rhs.len();
         if symmetric {

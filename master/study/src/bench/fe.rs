@@ -35,8 +35,8 @@ pub fn fe_panel(n: usize) -> cosdem_fem::Result<(Solver, ElasticCosserat)> {
 
 /// The FE cost of one Newton iteration on the `n x n` Q8 panel (2x2 Gauss points, elastic
 /// Cosserat material), averaged over `reps` iterations after a first one that includes the
-/// symbolic analysis. Returns (free dofs, Gauss points, seconds per iteration).
-pub fn fe_iteration(n: usize, reps: usize) -> BenchResult<(usize, usize, f64)> {
+/// symbolic analysis. Returns (free dofs, Gauss points, seconds per iteration split by part).
+pub fn fe_iteration(n: usize, reps: usize) -> BenchResult<(usize, usize, IterationTiming)> {
     let (mut solver, mut mat) = fe_panel(n)?;
     solver.iteration_work(&mut mat)?; // symbolic analysis
     let mut sum = IterationTiming::default();
@@ -47,9 +47,14 @@ pub fn fe_iteration(n: usize, reps: usize) -> BenchResult<(usize, usize, f64)> {
         sum.assembly_s += t.assembly_s;
         sum.solve_s += t.solve_s;
     }
-    let per = (sum.material_s + sum.assembly_s + sum.solve_s) / reps as f64;
+    let per = |s: f64| s / reps as f64;
+    let mean = IterationTiming {
+        material_s: per(sum.material_s),
+        assembly_s: per(sum.assembly_s),
+        solve_s: per(sum.solve_s),
+    };
     let gauss = solver.gauss().len();
-    Ok((solver.dofs().n_free, gauss, per))
+    Ok((solver.dofs().n_free, gauss, mean))
 }
 
 /// Figure 3: FE cost of one Newton iteration of the `elements x elements` scene against the
@@ -63,10 +68,15 @@ pub fn fe_versus_dem(
 ) -> BenchResult<()> {
     let spec = hexagonal_spec(discs);
     let (mut fe, mut dem, mut ratio) = (Vec::new(), Vec::new(), Vec::new());
+    let mut parts: [Vec<f64>; 3] = Default::default();
     let (mut dofs, mut gauss, mut n_discs) = (0, 0, 0);
     for rep in 0..repeats {
-        let (d, g, f) = fe_iteration(elements, 20)?;
+        let (d, g, t) = fe_iteration(elements, 20)?;
         (dofs, gauss) = (d, g);
+        let f = t.material_s + t.assembly_s + t.solve_s;
+        for (p, s) in parts.iter_mut().zip([t.material_s, t.assembly_s, t.solve_s]) {
+            p.push(s);
+        }
         let (run, n) = run_direct(&spec, 8, iterations)?;
         n_discs = n;
         let dem_iteration = g as f64 * run.per_solve();
@@ -93,6 +103,16 @@ pub fn fe_versus_dem(
         "  FE (material + assembly + factorization + solve): {} ms",
         Spread::of(&fe).show(1e3, 3)
     )?;
+    for (name, p) in [
+        "material (kinematics, stress, tangent)",
+        "assembly (residual, tangent)",
+        "factorization + solve",
+    ]
+    .iter()
+    .zip(&parts)
+    {
+        writeln!(out, "    {name:<38}: {} ms", Spread::of(p).show(1e3, 3))?;
+    }
     writeln!(
         out,
         "  DEM ({gauss} x direct solve)                      : {} ms",
