@@ -104,9 +104,9 @@ pub fn split(n: usize, steps: u64) -> Result<Split> {
 /// The force kernel alone: the hexagonal assembly of about `n` discs after [`rate`]'s warm-up
 /// (every neighbour pair in contact), its forces computed `passes` times from the same state
 /// (the histories advance, nothing moves), by the kernel of every solve or, with `one_at_a_time`,
-/// by [`crate::contact::kernel::accumulate_scalar`]. Returns (pairs, seconds per pair).
+/// one pair at a time ([`crate::contact::kernel::accumulate_with`]). Returns (pairs, seconds per pair).
 pub fn pair_cost(n: usize, passes: usize, one_at_a_time: bool) -> Result<(usize, f64)> {
-    use crate::contact::kernel::{Accum, Bodies, accumulate, accumulate_scalar};
+    use crate::contact::kernel::{Accum, Bodies, accumulate_with};
     let mut a = hexagonal(n)?;
     let mut strain = 0.0;
     compress(&mut a, &mut strain, 10 * CHUNK, None)?;
@@ -122,8 +122,8 @@ pub fn pair_cost(n: usize, passes: usize, one_at_a_time: bool) -> Result<(usize,
             f.fill(0.0);
         }
         let mut acc = Accum { fx: &mut fx, fy: &mut fy, tq: &mut tq };
-        let kernel = if one_at_a_time { accumulate_scalar } else { accumulate };
-        std::hint::black_box(kernel(&law, a.time_step(), b, &mut pairs, &mut acc));
+        let sums = accumulate_with(!one_at_a_time, &law, a.time_step(), b, &mut pairs, &mut acc);
+        std::hint::black_box(sums);
     }
     let per = t0.elapsed().as_secs_f64() / (passes.max(1) * pairs.len().max(1)) as f64;
     Ok((pairs.len(), per))

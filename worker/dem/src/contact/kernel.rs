@@ -53,22 +53,14 @@ pub fn accumulate(
     pl: &mut PairList,
     acc: &mut Accum<'_>,
 ) -> ContactSums {
-    let per = !pl.ox.is_empty();
-    match (law.has_rolling(), law.has_damping(), per) {
-        (true, true, true) => run::<true, true, true>(law, dt, b, pl, acc),
-        (true, true, false) => run::<true, true, false>(law, dt, b, pl, acc),
-        (true, false, true) => run::<true, false, true>(law, dt, b, pl, acc),
-        (true, false, false) => run::<true, false, false>(law, dt, b, pl, acc),
-        (false, true, true) => run::<false, true, true>(law, dt, b, pl, acc),
-        (false, true, false) => run::<false, true, false>(law, dt, b, pl, acc),
-        (false, false, true) => run::<false, false, true>(law, dt, b, pl, acc),
-        (false, false, false) => run::<false, false, false>(law, dt, b, pl, acc),
-    }
+    accumulate_with(true, law, dt, b, pl, acc)
 }
 
-/// [`accumulate`] one pair at a time, without the four-lane kernel: the same result bit for
-/// bit (the benchmark's yardstick for what the lanes gain).
-pub fn accumulate_scalar(
+/// [`accumulate`], four pairs at a time when `lanes` (and the processor has AVX2), else one
+/// pair at a time: the same result bit for bit either way (`lanes = false` is the benchmark's
+/// yardstick for what the lanes gain).
+pub fn accumulate_with(
+    lanes: bool,
     law: &Law,
     dt: f64,
     b: Bodies<'_>,
@@ -76,36 +68,36 @@ pub fn accumulate_scalar(
     acc: &mut Accum<'_>,
 ) -> ContactSums {
     let per = !pl.ox.is_empty();
-    let s = ContactSums::default();
     match (law.has_rolling(), law.has_damping(), per) {
-        (true, true, true) => scalar::<true, true, true>(law, dt, b, pl, acc, 0, s),
-        (true, true, false) => scalar::<true, true, false>(law, dt, b, pl, acc, 0, s),
-        (true, false, true) => scalar::<true, false, true>(law, dt, b, pl, acc, 0, s),
-        (true, false, false) => scalar::<true, false, false>(law, dt, b, pl, acc, 0, s),
-        (false, true, true) => scalar::<false, true, true>(law, dt, b, pl, acc, 0, s),
-        (false, true, false) => scalar::<false, true, false>(law, dt, b, pl, acc, 0, s),
-        (false, false, true) => scalar::<false, false, true>(law, dt, b, pl, acc, 0, s),
-        (false, false, false) => scalar::<false, false, false>(law, dt, b, pl, acc, 0, s),
+        (true, true, true) => run::<true, true, true>(lanes, law, dt, b, pl, acc),
+        (true, true, false) => run::<true, true, false>(lanes, law, dt, b, pl, acc),
+        (true, false, true) => run::<true, false, true>(lanes, law, dt, b, pl, acc),
+        (true, false, false) => run::<true, false, false>(lanes, law, dt, b, pl, acc),
+        (false, true, true) => run::<false, true, true>(lanes, law, dt, b, pl, acc),
+        (false, true, false) => run::<false, true, false>(lanes, law, dt, b, pl, acc),
+        (false, false, true) => run::<false, false, true>(lanes, law, dt, b, pl, acc),
+        (false, false, false) => run::<false, false, false>(lanes, law, dt, b, pl, acc),
     }
 }
 
-/// One monomorphization: the four-lane kernel over the whole fours, then the rest one pair
-/// at a time.
+/// One monomorphization: with `lanes` (and AVX2), the four-lane kernel over the whole fours,
+/// then the rest one pair at a time.
 #[inline(never)]
 fn run<const ROLL: bool, const DAMP: bool, const PER: bool>(
+    lanes: bool,
     law: &Law,
     dt: f64,
     b: Bodies<'_>,
     pl: &mut PairList,
     acc: &mut Accum<'_>,
 ) -> ContactSums {
-    let m = pl.i.len();
     #[cfg(target_arch = "x86_64")]
-    if let Some(simd) = super::simd::token() {
-        let whole = m - m % 4;
+    if let (true, Some(simd)) = (lanes, super::simd::token()) {
+        let whole = pl.i.len() - pl.i.len() % 4;
         let head = super::simd::run::<ROLL, DAMP, PER>(simd, law, dt, b, pl, acc, whole);
         return scalar::<ROLL, DAMP, PER>(law, dt, b, pl, acc, whole, head);
     }
+    let _ = lanes;
     scalar::<ROLL, DAMP, PER>(law, dt, b, pl, acc, 0, ContactSums::default())
 }
 
