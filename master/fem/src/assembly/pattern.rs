@@ -15,7 +15,7 @@ pub struct Pattern {
     /// Where each element's tangent goes: for element `e`, from `scatter_start[e]`, the
     /// position in the value array of its entry `(i, j)` (element dofs, row-major), or
     /// [`NOT_FREE`] where the row or the column is prescribed. Looked up once here, so an
-    /// assembly does not search the columns again (the search was about a third of it).
+    /// assembly does not search the columns again (the search was more than half of it).
     pub scatter: Vec<u32>,
     /// Start of each element's entries in `scatter` (length `n_elements + 1`).
     pub scatter_start: Vec<usize>,

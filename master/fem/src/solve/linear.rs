@@ -33,6 +33,7 @@ impl LinearSolver {
             None,
             pattern.row_idx.clone(),
         );
+        faer::set_global_parallelism(Par::Seq);
         Ok(Self { symbolic, lu: None, llt: None })
     }
 
@@ -50,7 +51,6 @@ impl LinearSolver {
         if rhs.is_empty() {
             return Ok(());
         }
-        faer::set_global_parallelism(Par::Seq);
         let k = SparseColMatRef::new(self.symbolic.as_ref(), values);
         let n = rhs.len();
         if symmetric {

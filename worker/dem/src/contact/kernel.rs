@@ -44,6 +44,14 @@ pub struct ContactSums {
     pub active: u32,
 }
 
+/// What one pass over a pair list reads besides the pairs: the law, the step and the discs.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Pass<'a> {
+    pub(super) law: &'a Law,
+    pub(super) dt: f64,
+    pub(super) b: Bodies<'a>,
+}
+
 /// Adds the contact forces of every pair to `acc` and advances the histories by `v dt`.
 /// Dispatches to the monomorphization matching the law and domain.
 pub fn accumulate(
@@ -68,15 +76,16 @@ pub fn accumulate_with(
     acc: &mut Accum<'_>,
 ) -> ContactSums {
     let per = !pl.ox.is_empty();
+    let s = Pass { law, dt, b };
     match (law.has_rolling(), law.has_damping(), per) {
-        (true, true, true) => run::<true, true, true>(lanes, law, dt, b, pl, acc),
-        (true, true, false) => run::<true, true, false>(lanes, law, dt, b, pl, acc),
-        (true, false, true) => run::<true, false, true>(lanes, law, dt, b, pl, acc),
-        (true, false, false) => run::<true, false, false>(lanes, law, dt, b, pl, acc),
-        (false, true, true) => run::<false, true, true>(lanes, law, dt, b, pl, acc),
-        (false, true, false) => run::<false, true, false>(lanes, law, dt, b, pl, acc),
-        (false, false, true) => run::<false, false, true>(lanes, law, dt, b, pl, acc),
-        (false, false, false) => run::<false, false, false>(lanes, law, dt, b, pl, acc),
+        (true, true, true) => run::<true, true, true>(lanes, s, pl, acc),
+        (true, true, false) => run::<true, true, false>(lanes, s, pl, acc),
+        (true, false, true) => run::<true, false, true>(lanes, s, pl, acc),
+        (true, false, false) => run::<true, false, false>(lanes, s, pl, acc),
+        (false, true, true) => run::<false, true, true>(lanes, s, pl, acc),
+        (false, true, false) => run::<false, true, false>(lanes, s, pl, acc),
+        (false, false, true) => run::<false, false, true>(lanes, s, pl, acc),
+        (false, false, false) => run::<false, false, false>(lanes, s, pl, acc),
     }
 }
 
@@ -85,28 +94,24 @@ pub fn accumulate_with(
 #[inline(never)]
 fn run<const ROLL: bool, const DAMP: bool, const PER: bool>(
     lanes: bool,
-    law: &Law,
-    dt: f64,
-    b: Bodies<'_>,
+    s: Pass<'_>,
     pl: &mut PairList,
     acc: &mut Accum<'_>,
 ) -> ContactSums {
     #[cfg(target_arch = "x86_64")]
     if let (true, Some(simd)) = (lanes, super::simd::token()) {
         let whole = pl.i.len() - pl.i.len() % 4;
-        let head = super::simd::run::<ROLL, DAMP, PER>(simd, law, dt, b, pl, acc, whole);
-        return scalar::<ROLL, DAMP, PER>(law, dt, b, pl, acc, whole, head);
+        let head = super::simd::run::<ROLL, DAMP, PER>(simd, s, pl, acc, whole);
+        return scalar::<ROLL, DAMP, PER>(s, pl, acc, whole, head);
     }
     let _ = lanes;
-    scalar::<ROLL, DAMP, PER>(law, dt, b, pl, acc, 0, ContactSums::default())
+    scalar::<ROLL, DAMP, PER>(s, pl, acc, 0, ContactSums::default())
 }
 
 /// The pairs from `start` on, one at a time, continuing `sums`: the reference the four-lane
 /// kernel reproduces.
 fn scalar<const ROLL: bool, const DAMP: bool, const PER: bool>(
-    law: &Law,
-    dt: f64,
-    b: Bodies<'_>,
+    Pass { law, dt, b }: Pass<'_>,
     pl: &mut PairList,
     acc: &mut Accum<'_>,
     start: usize,

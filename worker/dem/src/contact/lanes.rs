@@ -6,8 +6,9 @@
 //! `-`, `*`, `/`, `sqrt`, `mul_add`, `max`, `min`, `abs`, comparisons) is correctly rounded or
 //! exact in IEEE 754, lane by lane. The lanes are plain arrays written so that LLVM's
 //! superword-level vectorizer turns each operation into one AVX2 instruction on the x86-64-v3
-//! baseline (`vaddpd`, `vsqrtpd`, `vfmadd...pd`, `vblendvpd`, ...): no `unsafe`, no intrinsics,
-//! and a build for another architecture gets correct scalar code.
+//! baseline (`vaddpd`, `vsqrtpd`, `vfmadd...pd`, ...), and a build for another architecture
+//! gets correct scalar code. The kernel's contact mask is the exception, written with vector
+//! instructions in [`super::simd`].
 
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
@@ -20,7 +21,7 @@ pub trait Real:
     + Div<Output = Self>
     + Neg<Output = Self>
 {
-    /// A lane mask: one `bool` per lane.
+    /// A lane mask: one flag per lane.
     type Mask: Copy;
     /// `v` in every lane.
     fn splat(v: f64) -> Self;
@@ -125,7 +126,7 @@ impl Neg for F4 {
 /// operations, which the compiler keeps in vector registers (a `[bool; 4]` mask made it branch
 /// lane by lane).
 #[inline(always)]
-pub fn lane_mask(b: bool) -> u64 {
+fn lane_mask(b: bool) -> u64 {
     (b as u64).wrapping_neg()
 }
 

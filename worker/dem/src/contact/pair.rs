@@ -13,27 +13,28 @@
 use super::lanes::Real;
 use super::{Law, normal, rolling, tangential};
 
-/// What one contact does to its two discs (force on `q`; `p` gets the opposite).
+/// What one contact does to its two discs (force on `q`; `p` gets the opposite), for one pair
+/// (`f64`) or four ([`super::lanes::F4`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PairForce {
+pub struct PairForce<R = f64> {
     /// Force on `q`, x component (N).
-    pub fx: f64,
+    pub fx: R,
     /// Force on `q`, y component (N).
-    pub fy: f64,
+    pub fy: R,
     /// Torque on `p` (N m).
-    pub tp: f64,
+    pub tp: R,
     /// Torque on `q` (N m).
-    pub tq: f64,
+    pub tq: R,
     /// Normal force magnitude `F_n >= 0`.
-    pub fnorm: f64,
+    pub fnorm: R,
     /// Tangential force `F_s` along `t = (-n_y, n_x)`.
-    pub fs: f64,
+    pub fs: R,
     /// Rolling moment `M_r` on `q`.
-    pub mr: f64,
+    pub mr: R,
     /// New tangential history.
-    pub hs: f64,
+    pub hs: R,
     /// New rolling history.
-    pub hr: f64,
+    pub hr: R,
 }
 
 /// Interaction of discs `p` and `q` with branch `(dx, dy) = x_q - x_p`, relative velocity
@@ -61,18 +62,7 @@ pub fn interact<const ROLL: bool, const DAMP: bool>(
         return None;
     }
     let g = geometry::<f64, ROLL>(dx, dy, rp, rq, d2);
-    let c = respond::<f64, ROLL, DAMP>(law, dt, &g, Motion { dvx, dvy, wp, wq }, hs, hr);
-    Some(PairForce {
-        fx: c.fx,
-        fy: c.fy,
-        tp: c.tp,
-        tq: c.tq,
-        fnorm: c.fnorm,
-        fs: c.fs,
-        mr: c.mr,
-        hs: c.hs,
-        hr: c.hr,
-    })
+    Some(respond::<f64, ROLL, DAMP>(law, dt, &g, Motion { dvx, dvy, wp, wq }, hs, hr))
 }
 
 /// The contact geometry of an overlapping pair, for one pair (`f64`) or four
@@ -94,8 +84,7 @@ pub struct Geometry<R> {
 }
 
 /// The geometry of a pair with branch `(dx, dy)`, radii `rp`, `rq` and `d2 = dx^2 + dy^2`
-/// (as `dx.mul_add(dx, dy * dy)`) below `(rp + rq)^2`. It holds the law's square root and
-/// divisions, apart from the rest so a kernel can run it over many pairs in a row.
+/// (as `dx.mul_add(dx, dy * dy)`) below `(rp + rq)^2`: the law's square root and divisions.
 #[inline(always)]
 pub fn geometry<R: Real, const ROLL: bool>(dx: R, dy: R, rp: R, rq: R, d2: R) -> Geometry<R> {
     let rs = rp + rq;
@@ -127,29 +116,6 @@ pub struct Motion<R> {
     pub wq: R,
 }
 
-/// [`PairForce`] at either width.
-#[derive(Clone, Copy, Debug)]
-pub struct Response<R> {
-    /// Force on `q`, x (N).
-    pub fx: R,
-    /// Force on `q`, y (N).
-    pub fy: R,
-    /// Torque on `p` (N m).
-    pub tp: R,
-    /// Torque on `q` (N m).
-    pub tq: R,
-    /// Normal force magnitude (N).
-    pub fnorm: R,
-    /// Tangential force (N).
-    pub fs: R,
-    /// Rolling moment on `q` (N m).
-    pub mr: R,
-    /// New tangential history.
-    pub hs: R,
-    /// New rolling history.
-    pub hr: R,
-}
-
 /// The law of an overlapping pair (Eqs. 13-23 with the levers of the module documentation)
 /// from its [`geometry`], its motion and its histories. The scalar [`interact`] and the
 /// four-lane kernel both call [`geometry`] then this, so a pair gets the same bits in either.
@@ -161,7 +127,7 @@ pub fn respond<R: Real, const ROLL: bool, const DAMP: bool>(
     m: Motion<R>,
     hs: R,
     hr: R,
-) -> Response<R> {
+) -> PairForce<R> {
     let Geometry { nx, ny, ov, ap, aq, rstar } = *g;
     let Motion { dvx, dvy, wp, wq } = m;
     // t = (-n_y, n_x)
@@ -179,7 +145,7 @@ pub fn respond<R: Real, const ROLL: bool, const DAMP: bool>(
     let fy = fnorm.mul_add(ny, fs * nx);
     let tq = (-aq).mul_add(fs, mr);
     let tp = (-ap).mul_add(fs, -mr);
-    Response { fx, fy, tp, tq, fnorm, fs, mr, hs, hr }
+    PairForce { fx, fy, tp, tq, fnorm, fs, mr, hs, hr }
 }
 
 /// Convenience wrapper choosing the monomorphization from the law (tests, tools).

@@ -22,8 +22,7 @@
 //! twelve reads of two discs and the six additions into them stay one value at a time. What
 //! was tried besides, and measured, is in `docs/notes/2026-12-06-simd-kernel.md`.
 
-use super::Law;
-use super::kernel::{Accum, Bodies, ContactSums};
+use super::kernel::{Accum, ContactSums, Pass};
 use super::lanes::{F4, Real};
 use super::pair::{Motion, geometry, respond};
 use crate::broadphase::PairList;
@@ -39,12 +38,9 @@ pub fn token() -> Option<V3> {
 /// Adds the forces of the first `whole` pairs (a multiple of four) to `acc`, as the scalar
 /// loop would, and returns their sums.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
-pub fn run<const ROLL: bool, const DAMP: bool, const PER: bool>(
+pub(super) fn run<const ROLL: bool, const DAMP: bool, const PER: bool>(
     simd: V3,
-    law: &Law,
-    dt: f64,
-    b: Bodies<'_>,
+    Pass { law, dt, b }: Pass<'_>,
     pl: &mut PairList,
     acc: &mut Accum<'_>,
     whole: usize,
