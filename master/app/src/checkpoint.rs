@@ -16,6 +16,14 @@
 //! `CDEMCKP4`: postcard without the solver's stage and the answers' micro descriptors), by
 //! name: that run must be restarted.
 //!
+//! A checkpoint of a [`crate::stepper::Stepper`] also holds the caller's stages so far
+//! (`Checkpoint::stages`), so that a resume goes on with the same loading: they follow the
+//! postcard checkpoint (inside the checksum) as one postcard string, the `[[stage]]` tables
+//! of a job file (TOML, whose numbers read back bit for bit). A run's checkpoint has nothing
+//! there: its bytes are those of a checkpoint before stepper checkpoints existed, and those
+//! read as ever. A run refuses to resume from a stepper's checkpoint and a stepper from a run's,
+//! naming the file.
+//!
 //! The checksum is a CRC-32 (`crc32fast`) rather than a 64-bit hash: it is guaranteed to catch
 //! every single-bit error and every burst of up to 32 bits (a damaged disk block, a bad copy),
 //! it is the standard polynomial any zlib recomputes, and it runs at memory speed; a damaged
@@ -37,7 +45,7 @@ use cosdem_common::micro::AssemblyState;
 use cosdem_fem::error::{Error, Result};
 use cosdem_fem::material::Material;
 use cosdem_fem::solve::{SolutionView, Solver, SolverState, StepControl, StepObserver, StepReport};
-use cosdem_job::Job;
+use cosdem_job::{Job, StageSection};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -79,6 +87,25 @@ pub struct Checkpoint {
     pub solver: SolverState,
     /// The material's committed states (empty for stateless materials).
     pub assemblies: Vec<SavedAssembly>,
+    /// A stepper's checkpoint: the caller's stages so far, in order (`None` for a run's).
+    /// Encoded after the rest (see the [module](self) doc), not by serde.
+    #[serde(skip)]
+    pub stages: Option<Vec<StageSection>>,
+    /// A stepper's checkpoint: the job it runs (the given job with its accuracy settings,
+    /// without its loads) as TOML text, so that a resume needs nothing but the checkpoint
+    /// ([`crate::stepper::Stepper::job_of`]). Encoded with the stages, not by serde.
+    #[serde(skip)]
+    pub job: Option<String>,
+}
+
+/// The `[[stage]]` tables of a job file, as a stepper's checkpoint stores the caller's stages.
+#[derive(Serialize, Deserialize)]
+struct StageTables {
+    /// The job the stepper runs, as TOML text.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    job: Option<String>,
+    #[serde(default)]
+    stage: Vec<StageSection>,
 }
 
 fn bad(path: &Path, message: String) -> Error {
@@ -115,7 +142,7 @@ impl Checkpoint {
         for g in &mut solver.gauss_points {
             g.diagnostics.wall_seconds = 0.0;
         }
-        Ok(Self { digests, solver, assemblies })
+        Ok(Self { digests, solver, assemblies, stages: None, job: None })
     }
 
     /// The material's committed states, for [`Material::restore_states`].
@@ -137,6 +164,14 @@ impl Checkpoint {
         let body = postcard::to_allocvec(self)
             .map_err(|e| bad(path, format!("encoding the checkpoint: {e}")))?;
         bytes.extend_from_slice(&body);
+        if let Some(stages) = &self.stages {
+            let tables = StageTables { job: self.job.clone(), stage: stages.clone() };
+            let text = toml::to_string(&tables)
+                .map_err(|e| bad(path, format!("encoding the stages as TOML: {e}")))?;
+            let trailer = postcard::to_allocvec(&text)
+                .map_err(|e| bad(path, format!("encoding the stages: {e}")))?;
+            bytes.extend_from_slice(&trailer);
+        }
         let crc = crc32fast::hash(&bytes);
         bytes.extend_from_slice(&crc.to_le_bytes());
         write_atomic(path, &bytes).map_err(|e| Error::Observer(e.to_string()))
@@ -189,12 +224,45 @@ impl Checkpoint {
                 ),
             ));
         }
-        let (c, trailing): (Self, &[u8]) = postcard::take_from_bytes(&covered[MAGIC.len()..])
-            .map_err(|e| bad(path, format!("cannot decode the checkpoint: {e}")))?;
+        let (mut c, trailing): (Self, &[u8]) =
+            postcard::take_from_bytes(&covered[MAGIC.len()..])
+                .map_err(|e| bad(path, format!("cannot decode the checkpoint: {e}")))?;
         if !trailing.is_empty() {
-            return Err(bad(path, "trailing bytes after the checkpoint".into()));
+            // A stepper's checkpoint: the caller's stages.
+            let (text, rest): (String, &[u8]) = postcard::take_from_bytes(trailing)
+                .map_err(|e| bad(path, format!("cannot decode the stepper's stages: {e}")))?;
+            if !rest.is_empty() {
+                return Err(bad(path, "trailing bytes after the checkpoint".into()));
+            }
+            let tables: StageTables = toml::from_str(&text)
+                .map_err(|e| bad(path, format!("cannot read the stepper's stages: {e}")))?;
+            c.stages = Some(tables.stage);
+            c.job = tables.job;
         }
         Ok(c)
+    }
+
+    /// Refuses a stepper's checkpoint to a run (`stepper = false`) and a run's to a stepper,
+    /// naming the file: each goes on with its own loading.
+    pub fn check_kind(&self, path: &Path, stepper: bool) -> Result<()> {
+        match (&self.stages, stepper) {
+            (Some(s), false) => Err(bad(
+                path,
+                format!(
+                    "the checkpoint was written by a stepper (cosdem_app::stepper, {} stage(s) \
+                     given by its caller), not by a run of the job: resume it with \
+                     Stepper::resume",
+                    s.len()
+                ),
+            )),
+            (None, true) => Err(bad(
+                path,
+                "the checkpoint was written by a run of the job (its own loading), not by a \
+                 stepper: resume it with `cosdem run --resume`"
+                    .into(),
+            )),
+            _ => Ok(()),
+        }
     }
 
     /// Refuses a checkpoint of another job's physics.

@@ -6,7 +6,9 @@ use crate::logging::LogFile;
 use crate::plot::plot;
 use anyhow::{Context, Result};
 use cosdem_app::output::run_dir::RunWriter;
-use cosdem_app::run::{Ending, HookError, Run, RunObserver, WorkerChoice};
+use cosdem_app::run::{
+    Ending, HookError, PROGRESS_TEMPLATE, Run, RunObserver, WorkerChoice, step_message,
+};
 use cosdem_fem::solve::{SolutionView, StepReport};
 use cosdem_job::Job;
 use cosdem_pool::PoolConfig;
@@ -125,12 +127,7 @@ impl RunObserver for Progress {
 
     fn on_start(&mut self) -> Result<(), HookError> {
         let bar = if self.quiet { ProgressBar::hidden() } else { ProgressBar::new(1000) };
-        bar.set_style(
-            ProgressStyle::with_template(
-                "[{elapsed_precise}] {bar:30} {percent:>3}% ETA {eta} {msg}",
-            )
-            .expect("static template"),
-        );
+        bar.set_style(ProgressStyle::with_template(PROGRESS_TEMPLATE).expect("static template"));
         self.bar = bar;
         self.span = Some(tracing::info_span!("run", job = %self.job.display()).entered());
         self.started = Instant::now();
@@ -144,18 +141,9 @@ impl RunObserver for Progress {
         record: Option<&RunWriter>,
     ) -> cosdem_fem::Result<()> {
         let Some(writer) = record else { return Ok(()) };
-        let sum = writer.summary();
-        let secs = self.started.elapsed().as_secs_f64().max(1e-9);
-        let discs_per_s = sum.dem_steps as f64 / secs;
         self.bar.set_position((r.load_factor * 1000.0).round() as u64);
-        self.bar.set_message(format!(
-            "step {} d={:.4e} m load={:.4e} N it={} DEM {:.2e} relax-steps/s",
-            r.step,
-            sum.displacement,
-            writer.curve().last().map_or(0.0, |p| p.1),
-            r.iterations,
-            discs_per_s
-        ));
+        self.bar.set_message(step_message(r, writer, self.started.elapsed().as_secs_f64()));
+        let sum = writer.summary();
         tracing::info!(
             step = r.step,
             load_factor = r.load_factor,

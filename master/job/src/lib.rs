@@ -14,6 +14,7 @@
 //!   ([`Job::element_materials`], [`Job::materials`]);
 //! - `specimens`: `[specimens]`, the distinct DEM specimens and their consolidation levels
 //!   ([`SpecimensSection::specimen_of`], [`SpecimensSection::level_of`]);
+//! - `table`: a job given as a TOML table (the Python package's `Job(dict)`), errors by key path;
 //! - `load`: reading TOML text or a regular file of at most [`MAX_JOB_FILE_BYTES`]
 //!   ([`Job::from_toml`], [`Job::load`]);
 //! - `bulk`: the bulk density of a DEM material from its assembly, for gravity;
@@ -40,6 +41,7 @@ mod region;
 mod schema;
 mod specimens;
 mod stage;
+mod table;
 mod validate;
 
 pub use curve::{CurveQuantity, CurveSection, PvdTime};
@@ -55,6 +57,7 @@ pub use schema::{
 pub use specimens::{Consolidation, SpecimenCount, SpecimensSection};
 pub use stage::{
     MAX_STAGES, SolverStage, StageGravity, StagePrescribed, StagePressure, StageRamp, StageSection,
-    StageTraction,
+    StageTraction, StagesSoFar,
 };
+pub use table::from_table;
 pub use validate::MAX_TANGENT_STRAIN;

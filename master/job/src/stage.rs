@@ -177,7 +177,7 @@ impl Edge {
 }
 
 /// Loads in force after the stages so far.
-#[derive(Default)]
+#[derive(Clone, Debug, Default)]
 struct InForce {
     /// Prescribed (set, component), in the order first prescribed.
     held: Vec<(String, Component)>,
@@ -185,6 +185,25 @@ struct InForce {
     edges: BTreeMap<(String, bool), Edge>,
     /// Body force density `[f_x, f_y]` per material (as numbered by [`Job::materials`]).
     gravity: Option<Vec<[f64; 2]>>,
+}
+
+/// What a job's stages so far leave in force, for expanding its stages one at a time
+/// ([`Job::next_stages`]).
+#[derive(Clone, Debug, Default)]
+pub struct StagesSoFar {
+    /// Loads in force.
+    force: InForce,
+    /// `[[stage]]` entries expanded so far.
+    count: usize,
+    /// The material of every element, from the first stage with gravity on (with regions).
+    element_materials: Option<Arc<Vec<usize>>>,
+}
+
+impl StagesSoFar {
+    /// `[[stage]]` entries expanded so far: the index the next one's errors name.
+    pub fn count(&self) -> usize {
+        self.count
+    }
 }
 
 fn component(c: ComponentChoice) -> Component {
@@ -232,26 +251,71 @@ impl Job {
         let mut out = Vec::new();
         let mut force = InForce::default();
         for (i, stage) in self.stage.iter().enumerate() {
-            let points = stage.prescribed.iter().map(|p| p.path.len()).max().unwrap_or(0);
-            for r in 0..stage.repeat {
-                for k in 0..points.max(1) {
-                    let loading =
-                        self.stage_loading(i, stage, k, &mut force, element_materials.as_ref())?;
-                    let mut name = stage.name.clone();
-                    if stage.repeat > 1 {
-                        name = format!("{name} {}/{}", r + 1, stage.repeat);
-                    }
-                    if points > 1 {
-                        name = format!("{name} point {}/{points}", k + 1);
-                    }
-                    out.push(SolverStage { loading, steps: stage.steps, name });
-                    if out.len() > MAX_STAGES {
-                        return Err(bad(
-                            key(i, ".repeat"),
-                            stage.repeat.to_string(),
-                            format!("the job expands to more than {MAX_STAGES} stages"),
-                        ));
-                    }
+            let more =
+                self.expand_stage(i, stage, &mut force, element_materials.as_ref(), out.len())?;
+            out.extend(more);
+        }
+        Ok(out)
+    }
+
+    /// The solver stages of `stage` when the stages before it are those of `so_far` (which
+    /// is updated): what [`Job::stages`] gives for it in a job whose `[[stage]]` list is the
+    /// stages so far followed by `stage`, by the same code, for a caller that gives a job's
+    /// stages one at a time (the application's stepper) in constant time per stage. `stage`
+    /// is checked as [`Job::validate`] checks a stage and its sets against `mesh`, the job's
+    /// mesh (errors name `stage[i]...` keys, `i` = [`StagesSoFar::count`]); after an error
+    /// `so_far` is as it was. The limit of [`MAX_STAGES`] applies to `stage`'s own
+    /// expansion.
+    pub fn next_stages(
+        &self,
+        stage: &StageSection,
+        so_far: &mut StagesSoFar,
+        mesh: &Mesh,
+    ) -> Result<Vec<SolverStage>> {
+        let i = so_far.count;
+        self.validate_staged_job()?;
+        self.validate_stage(i, stage)?;
+        self.check_sets_of_stage(i, stage, mesh)?;
+        let mut next = so_far.clone();
+        if next.element_materials.is_none() && !self.region.is_empty() && stage.gravity.is_some() {
+            next.element_materials = Some(Arc::new(self.element_materials(mesh)?));
+        }
+        let out =
+            self.expand_stage(i, stage, &mut next.force, next.element_materials.as_ref(), 0)?;
+        next.count += 1;
+        *so_far = next;
+        Ok(out)
+    }
+
+    /// The solver stages of stage `i` (repetitions and path points), given what is in force
+    /// (updated) and `before` solver stages before it (for [`MAX_STAGES`]).
+    fn expand_stage(
+        &self,
+        i: usize,
+        stage: &StageSection,
+        force: &mut InForce,
+        element_materials: Option<&Arc<Vec<usize>>>,
+        before: usize,
+    ) -> Result<Vec<SolverStage>> {
+        let mut out = Vec::new();
+        let points = stage.prescribed.iter().map(|p| p.path.len()).max().unwrap_or(0);
+        for r in 0..stage.repeat {
+            for k in 0..points.max(1) {
+                let loading = self.stage_loading(i, stage, k, force, element_materials)?;
+                let mut name = stage.name.clone();
+                if stage.repeat > 1 {
+                    name = format!("{name} {}/{}", r + 1, stage.repeat);
+                }
+                if points > 1 {
+                    name = format!("{name} point {}/{points}", k + 1);
+                }
+                out.push(SolverStage { loading, steps: stage.steps, name });
+                if before + out.len() > MAX_STAGES {
+                    return Err(bad(
+                        key(i, ".repeat"),
+                        stage.repeat.to_string(),
+                        format!("the job expands to more than {MAX_STAGES} stages"),
+                    ));
                 }
             }
         }
@@ -422,6 +486,14 @@ impl Job {
     /// Checks that every set the stages name is in `mesh` and not empty (node sets for
     /// prescribed dofs, edge sets for pressures and tractions), naming the key.
     pub(crate) fn check_stage_sets(&self, mesh: &Mesh) -> Result<()> {
+        for (i, s) in self.stage.iter().enumerate() {
+            self.check_sets_of_stage(i, s, mesh)?;
+        }
+        Ok(())
+    }
+
+    /// [`Job::check_stage_sets`] of stage `i`, `s`.
+    fn check_sets_of_stage(&self, i: usize, s: &StageSection, mesh: &Mesh) -> Result<()> {
         let unknown = |field: &'static str, set: &str, kind: &str, known: Vec<&String>| {
             let known: Vec<&str> = known.into_iter().map(String::as_str).collect();
             bad(
@@ -433,28 +505,23 @@ impl Job {
                 ),
             )
         };
-        for (i, s) in self.stage.iter().enumerate() {
-            for (j, p) in s.prescribed.iter().enumerate() {
-                if mesh.node_sets.get(&p.set).is_none_or(Vec::is_empty) {
-                    let at = key(i, &format!(".prescribed[{j}].set"));
-                    return Err(unknown(at, &p.set, "node", mesh.node_sets.keys().collect()));
-                }
+        for (j, p) in s.prescribed.iter().enumerate() {
+            if mesh.node_sets.get(&p.set).is_none_or(Vec::is_empty) {
+                let at = key(i, &format!(".prescribed[{j}].set"));
+                return Err(unknown(at, &p.set, "node", mesh.node_sets.keys().collect()));
             }
-            let edges = s
-                .pressure
-                .iter()
-                .enumerate()
-                .map(|(j, p)| (format!(".pressure[{j}].set"), &p.set))
-                .chain(
-                    s.traction
-                        .iter()
-                        .enumerate()
-                        .map(|(j, t)| (format!(".traction[{j}].set"), &t.set)),
-                );
-            for (at, set) in edges {
-                if mesh.edge_sets.get(set).is_none_or(Vec::is_empty) {
-                    return Err(unknown(key(i, &at), set, "edge", mesh.edge_sets.keys().collect()));
-                }
+        }
+        let edges = s
+            .pressure
+            .iter()
+            .enumerate()
+            .map(|(j, p)| (format!(".pressure[{j}].set"), &p.set))
+            .chain(
+                s.traction.iter().enumerate().map(|(j, t)| (format!(".traction[{j}].set"), &t.set)),
+            );
+        for (at, set) in edges {
+            if mesh.edge_sets.get(set).is_none_or(Vec::is_empty) {
+                return Err(unknown(key(i, &at), set, "edge", mesh.edge_sets.keys().collect()));
             }
         }
         Ok(())
@@ -467,6 +534,15 @@ impl Job {
         if !self.is_staged() {
             return Ok(());
         }
+        self.validate_staged_job()?;
+        for (i, s) in self.stage.iter().enumerate() {
+            self.validate_stage(i, s)?;
+        }
+        Ok(())
+    }
+
+    /// What a job in stages may not have: `[loading]` loads, an accuracy target.
+    fn validate_staged_job(&self) -> Result<()> {
         let l = &self.loading;
         if l.compression.is_some()
             || !l.prescribed.is_empty()
@@ -488,95 +564,96 @@ impl Job {
                 "an accuracy target plans a one-stage job; a job in [[stage]] gives each stage's steps",
             ));
         }
-        for (i, s) in self.stage.iter().enumerate() {
-            if s.steps == 0 || s.steps > cosdem_fem::solve::MAX_LOAD_STEPS {
+        Ok(())
+    }
+
+    /// [`Job::validate_stages`] of stage `i`, `s`.
+    fn validate_stage(&self, i: usize, s: &StageSection) -> Result<()> {
+        if s.steps == 0 || s.steps > cosdem_fem::solve::MAX_LOAD_STEPS {
+            return Err(bad(
+                key(i, ".steps"),
+                s.steps.to_string(),
+                format!("must be 1 to {}", cosdem_fem::solve::MAX_LOAD_STEPS),
+            ));
+        }
+        if s.repeat == 0 || s.repeat > MAX_STAGES {
+            return Err(bad(
+                key(i, ".repeat"),
+                s.repeat.to_string(),
+                format!("must be 1 to {MAX_STAGES}"),
+            ));
+        }
+        let mut paths = None;
+        for (j, p) in s.prescribed.iter().enumerate() {
+            let at = |k: &str| key(i, &format!(".prescribed[{j}]{k}"));
+            let given = [p.value.is_some(), p.increment.is_some(), !p.path.is_empty(), p.free];
+            if given.iter().filter(|g| **g).count() != 1 {
                 return Err(bad(
-                    key(i, ".steps"),
-                    s.steps.to_string(),
-                    format!("must be 1 to {}", cosdem_fem::solve::MAX_LOAD_STEPS),
+                    at(""),
+                    format!("set = {:?}", p.set),
+                    "give exactly one of value, increment, path or free = true",
                 ));
             }
-            if s.repeat == 0 || s.repeat > MAX_STAGES {
+            for v in p.value.iter().chain(&p.increment).chain(&p.path) {
+                if !v.is_finite() {
+                    return Err(bad(at(""), format!("{v:?}"), "must be finite"));
+                }
+            }
+            if !p.path.is_empty() {
+                match paths {
+                    Some(n) if n != p.path.len() => {
+                        return Err(bad(
+                            at(".path"),
+                            format!("{} points", p.path.len()),
+                            format!("the stage's other path has {n}: paths of a stage go together"),
+                        ));
+                    }
+                    _ => paths = Some(p.path.len()),
+                }
+            }
+        }
+        for (j, p) in s.pressure.iter().enumerate() {
+            if !p.value.is_finite() {
                 return Err(bad(
-                    key(i, ".repeat"),
-                    s.repeat.to_string(),
-                    format!("must be 1 to {MAX_STAGES}"),
+                    key(i, &format!(".pressure[{j}].value")),
+                    format!("{:?}", p.value),
+                    "must be finite",
                 ));
             }
-            let mut paths = None;
-            for (j, p) in s.prescribed.iter().enumerate() {
-                let at = |k: &str| key(i, &format!(".prescribed[{j}]{k}"));
-                let given = [p.value.is_some(), p.increment.is_some(), !p.path.is_empty(), p.free];
-                if given.iter().filter(|g| **g).count() != 1 {
-                    return Err(bad(
-                        at(""),
-                        format!("set = {:?}", p.set),
-                        "give exactly one of value, increment, path or free = true",
-                    ));
-                }
-                for v in p.value.iter().chain(&p.increment).chain(&p.path) {
-                    if !v.is_finite() {
-                        return Err(bad(at(""), format!("{v:?}"), "must be finite"));
-                    }
-                }
-                if !p.path.is_empty() {
-                    match paths {
-                        Some(n) if n != p.path.len() => {
-                            return Err(bad(
-                                at(".path"),
-                                format!("{} points", p.path.len()),
-                                format!(
-                                    "the stage's other path has {n}: paths of a stage go together"
-                                ),
-                            ));
-                        }
-                        _ => paths = Some(p.path.len()),
-                    }
-                }
+        }
+        for (j, t) in s.traction.iter().enumerate() {
+            if !t.value.iter().all(|v| v.is_finite()) {
+                return Err(bad(
+                    key(i, &format!(".traction[{j}].value")),
+                    format!("{:?}", t.value),
+                    "must be finite",
+                ));
             }
-            for (j, p) in s.pressure.iter().enumerate() {
-                if !p.value.is_finite() {
-                    return Err(bad(
-                        key(i, &format!(".pressure[{j}].value")),
-                        format!("{:?}", p.value),
-                        "must be finite",
-                    ));
-                }
+        }
+        if let Some(g) = &s.gravity {
+            if !g.acceleration.iter().all(|v| v.is_finite()) {
+                return Err(bad(
+                    key(i, ".gravity.acceleration"),
+                    format!("{:?}", g.acceleration),
+                    "must be finite",
+                ));
             }
-            for (j, t) in s.traction.iter().enumerate() {
-                if !t.value.iter().all(|v| v.is_finite()) {
+            match g.density {
+                Some(rho) if !(rho.is_finite() && rho > 0.0) => {
                     return Err(bad(
-                        key(i, &format!(".traction[{j}].value")),
-                        format!("{:?}", t.value),
-                        "must be finite",
+                        key(i, ".gravity.density"),
+                        format!("{rho:?}"),
+                        "a body force needs the material's bulk density (kg/m^3, finite and > 0)",
                     ));
                 }
-            }
-            if let Some(g) = &s.gravity {
-                if !g.acceleration.iter().all(|v| v.is_finite()) {
+                None if g.ramp != StageRamp::Remove && !self.weighs_without_stage_density() => {
                     return Err(bad(
-                        key(i, ".gravity.acceleration"),
-                        format!("{:?}", g.acceleration),
-                        "must be finite",
+                        key(i, ".gravity.density"),
+                        "missing",
+                        "a body force needs the material's bulk density (kg/m^3, finite and > 0); it may be left out only when every material is DEM (weighed from its assembly) or its [[region]] gives a bulk_density, or with ramp = \"remove\"",
                     ));
                 }
-                match g.density {
-                    Some(rho) if !(rho.is_finite() && rho > 0.0) => {
-                        return Err(bad(
-                            key(i, ".gravity.density"),
-                            format!("{rho:?}"),
-                            "a body force needs the material's bulk density (kg/m^3, finite and > 0)",
-                        ));
-                    }
-                    None if g.ramp != StageRamp::Remove && !self.weighs_without_stage_density() => {
-                        return Err(bad(
-                            key(i, ".gravity.density"),
-                            "missing",
-                            "a body force needs the material's bulk density (kg/m^3, finite and > 0); it may be left out only when every material is DEM (weighed from its assembly) or its [[region]] gives a bulk_density, or with ramp = \"remove\"",
-                        ));
-                    }
-                    _ => {}
-                }
+                _ => {}
             }
         }
         Ok(())

@@ -201,3 +201,68 @@ fn unknown_sets_and_removals_of_nothing_are_refused() {
     let e = job.stages().unwrap_err().to_string();
     assert!(e.contains("stage[0].pressure[0].set") && e.contains("no earlier stage"), "{e}");
 }
+
+/// The stages given one at a time (`next_stages`, as the application's stepper gives them)
+/// are `stages` (the same loadings, compared through their debug text, every number written
+/// out), with regions and gravity too. A bad stage is refused naming its key (its index is the
+/// count so far) and leaves what is in force as it was: the next good stage expands as if the
+/// bad one had not been given.
+#[test]
+fn stages_one_at_a_time_are_the_jobs_stages() {
+    let text = |s: &[SolverStage]| format!("{s:?}");
+    let job = staged(LOAD_UNLOAD).unwrap();
+    let mesh = job.build_mesh().unwrap();
+    let base = Job { stage: Vec::new(), ..job.clone() };
+    let mut so_far = cosdem_job::StagesSoFar::default();
+    let mut one_by_one = Vec::new();
+    for (i, stage) in job.stage.iter().enumerate() {
+        if i == 1 {
+            let mut bad = stage.clone();
+            bad.steps = 0;
+            let e = base.next_stages(&bad, &mut so_far, &mesh).unwrap_err().to_string();
+            assert!(e.contains("stage[1].steps"), "{e}");
+            let mut bad = stage.clone();
+            bad.prescribed[0].set = "lid".into();
+            let e = base.next_stages(&bad, &mut so_far, &mesh).unwrap_err().to_string();
+            assert!(e.contains("stage[1].prescribed[0].set") && e.contains("lid"), "{e}");
+            assert!(e.contains("known: ") && e.contains("top"), "{e}");
+        }
+        one_by_one.extend(base.next_stages(stage, &mut so_far, &mesh).unwrap());
+    }
+    assert_eq!(so_far.count(), 3);
+    assert_eq!(text(&one_by_one), text(&job.stages().unwrap()));
+
+    let regions = Job::from_toml(
+        &cosdem_job::fixtures::text("rectangle-two-regions"),
+        "rectangle-two-regions.toml",
+    )
+    .unwrap();
+    let gravity = r#"
+[[stage]]
+prescribed = [{ set = "bottom", component = "uy", value = 0.0 },
+              { set = "bottom", component = "ux", value = 0.0 }]
+gravity = { acceleration = [0.0, -9.81], density = 1800.0 }
+[[stage]]
+prescribed = [{ set = "top", component = "uy", increment = -1e-3 }]
+[[stage]]
+gravity = { acceleration = [0.0, -9.81], ramp = "remove" }
+"#;
+    let mut job = regions.clone();
+    job.loading = Default::default();
+    job.stage = toml::from_str::<StageList>(gravity).unwrap().stage;
+    job.validate().unwrap();
+    let mesh = job.build_mesh().unwrap();
+    let base = Job { stage: Vec::new(), ..job.clone() };
+    let mut so_far = cosdem_job::StagesSoFar::default();
+    let mut one_by_one = Vec::new();
+    for stage in &job.stage {
+        one_by_one.extend(base.next_stages(stage, &mut so_far, &mesh).unwrap());
+    }
+    assert_eq!(text(&one_by_one), text(&job.stages().unwrap()));
+}
+
+/// `[[stage]]` tables alone.
+#[derive(serde::Deserialize)]
+struct StageList {
+    stage: Vec<cosdem_job::StageSection>,
+}

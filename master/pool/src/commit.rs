@@ -171,10 +171,7 @@ impl Pool {
     pub(crate) async fn rollback_async(&mut self) -> Result<(), MaterialError> {
         self.flush_deferred().await?;
         self.last = None;
-        let mut by_worker: BTreeMap<usize, Vec<GaussPointId>> = BTreeMap::new();
-        for (id, w) in &self.owner {
-            by_worker.entry(*w).or_default().push(*id);
-        }
+        let by_worker = self.owned_by_worker();
         let t = self.config.call_timeout;
         let jobs = by_worker
             .into_iter()
@@ -247,12 +244,17 @@ impl Pool {
         Ok(())
     }
 
-    /// Places saved committed states (a checkpoint) on the live workers: the pool then holds
-    /// exactly those assemblies, committed at the saved step. Ids must not have assemblies yet.
+    /// Places saved committed states (a checkpoint, or states exported earlier) on the live
+    /// workers: the pool then holds exactly those assemblies, committed at the saved step. A
+    /// pool that holds assemblies drops them all first ([`Pool::drop_all`]): it goes back to
+    /// the saved states (a caller that undoes committed steps).
     pub(crate) async fn import_states(
         &mut self,
         states: Vec<AssemblyState>,
     ) -> Result<(), MaterialError> {
+        if !self.owner.is_empty() {
+            self.drop_all().await?;
+        }
         let mut ids = Vec::with_capacity(states.len());
         for s in states {
             if self.owner.contains_key(&s.id) {
@@ -270,6 +272,42 @@ impl Pool {
         self.restore(&ids).await?;
         // Not a failover: the restorations above are the resume, not a recovery.
         self.stats.restored = self.stats.restored.saturating_sub(ids.len() as u64);
+        Ok(())
+    }
+
+    /// Every assembly's id, grouped by the worker that holds it.
+    fn owned_by_worker(&self) -> BTreeMap<usize, Vec<GaussPointId>> {
+        let mut by_worker: BTreeMap<usize, Vec<GaussPointId>> = BTreeMap::new();
+        for (id, w) in &self.owner {
+            by_worker.entry(*w).or_default().push(*id);
+        }
+        by_worker
+    }
+
+    /// Drops every assembly from its worker and forgets them: their committed history, last
+    /// trial, held-back commits and the step committed. A worker lost on the way is marked
+    /// dead (its assemblies are gone anyway); one that refuses is an error.
+    async fn drop_all(&mut self) -> Result<(), MaterialError> {
+        let by_worker = self.owned_by_worker();
+        let t = self.config.call_timeout;
+        let jobs = by_worker
+            .into_iter()
+            .filter(|(w, _)| self.workers[*w].alive)
+            .map(|(w, ids)| {
+                let link = self.workers[w].link.clone();
+                let job: Job<_> = Box::pin(async move { link.drop_assemblies(&ids, t).await });
+                (w, job)
+            })
+            .collect();
+        self.round(jobs, is_worker_failure, |pool, w, r| {
+            r.map_err(|s| pool.unavailable(w, "drop of the assemblies", &s))
+        })
+        .await?;
+        self.owner.clear();
+        self.history.clear();
+        self.deferred.clear();
+        self.last = None;
+        self.committed_step = 0;
         Ok(())
     }
 }

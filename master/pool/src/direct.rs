@@ -89,13 +89,17 @@ impl Material for DirectDem {
         ))
     }
 
+    /// Replaces the assemblies of `states` (those of a checkpoint, or states exported
+    /// earlier: the material goes back to them) and takes their committed step.
     fn restore_states(&mut self, states: Vec<AssemblyState>) -> Result<(), MaterialError> {
+        let mut step = 0;
         for s in states {
             let a = Assembly::from_bytes(&s.state)
                 .map_err(|e| MaterialError::Unavailable(format!("restoring {}: {e}", s.id)))?;
-            self.committed_step = self.committed_step.max(s.committed_step);
+            step = step.max(s.committed_step);
             self.assemblies.insert(s.id, a);
         }
+        self.committed_step = step;
         Ok(())
     }
 }

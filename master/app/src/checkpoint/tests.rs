@@ -209,6 +209,8 @@ fn awkward() -> Checkpoint {
             disc_count: 2,
             state: (0u8..40).collect(),
         }],
+        stages: None,
+        job: None,
     }
 }
 
@@ -290,5 +292,73 @@ fn old_and_foreign_files_are_refused_by_name() {
     std::fs::write(&path, b"CDEMCKP7").unwrap();
     let short = Checkpoint::read(&path).unwrap_err().to_string();
     assert!(short.contains("truncated"), "{short}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A run's checkpoint is the format as it was before stepper checkpoints: the header, the
+/// postcard checkpoint and the CRC, nothing else (so a run's `checkpoint.bin` keeps its bytes
+/// and older ones read). A stepper's checkpoint adds its caller's stages, which read back
+/// equal, every number bit for bit (compared through the bit patterns: `-0.0 == 0.0`), and
+/// each kind is refused where the other is expected, naming the file.
+#[test]
+fn a_stepper_checkpoint_keeps_its_stages_and_a_runs_keeps_its_bytes() {
+    use cosdem_job::{ComponentChoice, StageGravity, StagePrescribed, StagePressure, StageRamp};
+    let dir = scratch("stages");
+    let path = dir.join(FILE);
+    let run = awkward();
+    run.write(&path).unwrap();
+    let bytes = std::fs::read(&path).unwrap();
+    let body = postcard::to_allocvec(&run).unwrap();
+    assert_eq!(&bytes[8..bytes.len() - 4], &body[..], "header, postcard body, CRC: nothing more");
+    let back = Checkpoint::read(&path).unwrap();
+    assert_eq!(back.stages, None);
+    back.check_kind(&path, false).unwrap();
+    let e = back.check_kind(&path, true).unwrap_err().to_string();
+    assert!(e.contains(FILE) && e.contains("not by a stepper"), "{e}");
+
+    let awkward_values = [0.1 + 0.2, -0.0, 1e-300, f64::MIN_POSITIVE / 3.0, -1.0 / 3.0];
+    let stage = |i: usize| StageSection {
+        name: format!("stage {i}"),
+        steps: 3,
+        repeat: 1,
+        prescribed: vec![StagePrescribed {
+            set: "top".into(),
+            component: ComponentChoice::Uy,
+            value: (i == 0).then_some(awkward_values[0]),
+            increment: (i == 1).then_some(awkward_values[1]),
+            path: if i == 2 { awkward_values.to_vec() } else { Vec::new() },
+            free: false,
+        }],
+        pressure: vec![StagePressure {
+            set: "left".into(),
+            value: awkward_values[2],
+            ramp: StageRamp::Linear,
+        }],
+        traction: Vec::new(),
+        gravity: (i == 1).then_some(StageGravity {
+            acceleration: [awkward_values[3], awkward_values[4]],
+            density: None,
+            ramp: StageRamp::Constant,
+        }),
+    };
+    let stepper = Checkpoint { stages: Some((0..3).map(stage).collect()), ..awkward() };
+    stepper.write(&path).unwrap();
+    let back = Checkpoint::read(&path).unwrap();
+    assert_eq!(back.stages, stepper.stages);
+    let numbers = |c: &Checkpoint| -> Vec<u64> {
+        let mut v = Vec::new();
+        for s in c.stages.as_ref().unwrap() {
+            let p = &s.prescribed[0];
+            v.extend(p.value.iter().chain(&p.increment).chain(&p.path).map(|x| x.to_bits()));
+            v.push(s.pressure[0].value.to_bits());
+            v.extend(s.gravity.iter().flat_map(|g| g.acceleration.map(f64::to_bits)));
+        }
+        v
+    };
+    assert_eq!(numbers(&back), numbers(&stepper));
+    assert_eq!(numbers(&back).len(), 1 + 1 + 5 + 3 + 2);
+    back.check_kind(&path, true).unwrap();
+    let e = back.check_kind(&path, false).unwrap_err().to_string();
+    assert!(e.contains(FILE) && e.contains("written by a stepper"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
 }

@@ -4,6 +4,7 @@
 
 use super::vtk::{CellType, DataArray, VtuPiece};
 use super::{Result, invalid};
+use cosdem_fem::solve::GaussPointState;
 use std::path::Path;
 
 /// The mesh with the nodal solution: one cell per element (8 nodes: `VTK_QUADRATIC_QUAD`,
@@ -84,6 +85,22 @@ pub fn particle_piece(
         force.push(f);
     }
     piece.add_cell_data(DataArray::scalars("normal_force", force));
+    piece
+}
+
+/// The Gauss points of a converged state as `vtk/gauss_NNNNN.vtu` holds them (its timestep
+/// aside): [`gauss_point_piece`] of their positions, strains and stresses, their micro
+/// descriptors ([`add_micro_descriptors`]), and the scalars `element_id` and `gauss_point_id`.
+pub fn gauss_state_piece(gauss_points: &[GaussPointState], lc: f64) -> VtuPiece {
+    let positions: Vec<[f64; 2]> = gauss_points.iter().map(|g| g.position).collect();
+    let strain: Vec<[f64; 6]> = gauss_points.iter().map(|g| g.strain).collect();
+    let stress: Vec<[f64; 6]> = gauss_points.iter().map(|g| g.stress).collect();
+    let mut piece = gauss_point_piece(&positions, &strain, &stress, lc);
+    add_micro_descriptors(&mut piece, gauss_points.iter().map(|g| g.diagnostics.descriptors));
+    let elements: Vec<u32> = gauss_points.iter().map(|g| g.id.element).collect();
+    let points: Vec<u32> = gauss_points.iter().map(|g| g.id.point).collect();
+    piece.add_point_data(DataArray::ids("element_id", &elements));
+    piece.add_point_data(DataArray::ids("gauss_point_id", &points));
     piece
 }
 

@@ -13,11 +13,11 @@
 
 use super::csv::CsvWriter;
 use super::curve_axes::CurveAxes;
-use super::pieces::{add_micro_descriptors, gauss_point_piece, nodal_piece};
+use super::pieces::{gauss_state_piece, nodal_piece};
 use super::pvd::PvdWriter;
 use super::snapshots::{SnapshotInbox, SnapshotTap};
 use super::visuals::{StepInfo, VisualOutputs, reached as done};
-use super::vtk::{DataArray, write_vtu_encoded};
+use super::vtk::write_vtu_encoded;
 use super::{OutputError, Result, write_atomic};
 use cosdem_common::Answer;
 use cosdem_common::GaussPointId;
@@ -425,6 +425,14 @@ impl RunWriter {
         SnapshotTap::new(material, snapshots, inbox)
     }
 
+    /// `material` wrapped as [`Self::watch`] wrapped it, delivering to this writer the
+    /// snapshots the last watch asked for: for a caller that runs the solver more than once
+    /// under one watch (the stepper runs it once per stage).
+    pub fn tap<'m>(&self, material: &'m mut dyn Material) -> SnapshotTap<'m> {
+        let (ids, inbox) = self.visuals.watched();
+        SnapshotTap::new(material, ids, inbox)
+    }
+
     /// Records the number of workers in the summary.
     pub fn set_workers(&mut self, n: usize) {
         self.summary.workers = n;
@@ -487,18 +495,8 @@ impl RunWriter {
         if let Some(pvd) = &mut self.fields {
             pvd.add(time, &path)?;
         }
-        let gp = view.gauss_points;
-        let positions: Vec<[f64; 2]> = gp.iter().map(|g| g.position).collect();
-        let strain: Vec<[f64; 6]> = gp.iter().map(|g| g.strain).collect();
-        let stress: Vec<[f64; 6]> = gp.iter().map(|g| g.stress).collect();
-        let mut piece =
-            gauss_point_piece(&positions, &strain, &stress, self.settings.internal_length);
-        add_micro_descriptors(&mut piece, gp.iter().map(|g| g.diagnostics.descriptors));
+        let mut piece = gauss_state_piece(view.gauss_points, self.settings.internal_length);
         piece.time = Some(time);
-        let elements: Vec<u32> = gp.iter().map(|g| g.id.element).collect();
-        let points: Vec<u32> = gp.iter().map(|g| g.id.point).collect();
-        piece.add_point_data(DataArray::ids("element_id", &elements));
-        piece.add_point_data(DataArray::ids("gauss_point_id", &points));
         let path = self.dir.join(format!("vtk/gauss_{step:05}.vtu"));
         write_vtu_encoded(&path, &piece, self.settings.vtk_encoding)?;
         if let Some(pvd) = &mut self.gauss {

@@ -77,6 +77,11 @@ impl VisualOutputs {
         Self { snapshot_ids, inbox, series: BTreeMap::new(), pending, packings: Default::default() }
     }
 
+    /// The Gauss points watched and the inbox their snapshots are delivered into.
+    pub(crate) fn watched(&self) -> (Vec<GaussPointId>, SnapshotInbox) {
+        (self.snapshot_ids.clone(), self.inbox.clone())
+    }
+
     /// Also writes each snapshot as packing files in `packings.formats`.
     pub fn with_packings(mut self, packings: PackingOutput) -> Self {
         self.packings = packings;

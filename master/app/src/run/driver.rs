@@ -1,24 +1,24 @@
 //! [`Run`]: the one way a job is run, whoever runs it (`cosdem run`, the speed/accuracy sweep,
 //! the RVE-size study, the tests).
 //!
-//! The order of a run: the accuracy target is planned ([`super::tuned`]); the run directory is
-//! created (and the caller told, [`RunObserver::on_dir`]) and the plan written into it; a
-//! resume reads and checks the checkpoint; the run writer is created (or continued); the
-//! solver and the material are built (the job's pool, or the caller's material) and the
-//! checkpoint's states restored; then the solver runs with one per-step hook
-//! ([`super::observer`]) and the summary gets its status.
+//! The order of a run: the setup (`run/setup.rs`, shared with the stepper: the accuracy
+//! plan, admission, the run directory claimed and told to the caller ([`RunObserver::on_dir`]),
+//! a resume's checkpoint read and checked, the solver and the material built with the
+//! checkpoint's states, the run writer created or continued); the checkpoint's solver state
+//! restored in its stage; then the solver runs with one per-step hook ([`super::observer`])
+//! and the summary gets its status.
 
 use super::observer::{RunObserver, Silent, StepHook};
-use super::{RunError, WorkerChoice, gauss_point_ids, material_for, run_settings, tuned};
-use crate::checkpoint::{self, Checkpoint, Checkpointer};
-use crate::output::claim::{Claim, Mode};
-use crate::output::provenance::{self, Origin};
-use crate::output::run_dir::{RunWriter, Summary};
-use crate::output::snapshots::resolve_snapshot_ids;
+use super::setup::{Loads, Prepared, ResumeFrom, Setup};
+use super::{RunError, WorkerChoice};
+use crate::checkpoint::{self, Checkpointer};
+use crate::output::claim::Mode;
+use crate::output::provenance::Origin;
+use crate::output::run_dir::Summary;
 use cosdem_common::GaussPointId;
 use cosdem_fem::material::Material;
 use cosdem_fem::solve::{Solver, StepObserver};
-use cosdem_job::{Job, SolverStage, admission};
+use cosdem_job::{Job, SolverStage};
 use std::path::Path;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
@@ -141,7 +141,7 @@ impl<'a> Run<'a> {
 
     /// Goes on from the run directory's checkpoint instead of starting again (checkpoints
     /// on). `newton_changed`: the job's `[newton]` settings may differ from the checkpoint's
-    /// (see [`Checkpoint::check_job`]).
+    /// (see [`crate::checkpoint::Checkpoint::check_job`]).
     pub fn resume(mut self, newton_changed: bool) -> Self {
         self.resume = Some(newton_changed);
         self.checkpoints = true;
@@ -244,94 +244,41 @@ impl<'a> Run<'a> {
         if dir.is_none() && checkpoints {
             return Err(RunError::NoRunDirectory);
         }
-        // `accuracy`: the settings picked for the target replace the job's (a pure function
-        // of the job, so a resume picks the same ones).
-        let (job, report) = tuned(self.job)?;
-        let job = &job;
-        // Admission: a job too large for this machine is refused before anything is built.
-        let in_process = material.is_some() || workers.addresses.is_empty();
-        let limit = max_memory.or_else(admission::default_memory_limit);
-        for line in super::admit(job, limit, in_process, workers.config.max_message_bytes)? {
-            observer.on_plan_line(&line);
-        }
-        // The directory is claimed (locked; a new run refused in a directory that holds
-        // one) before anything is built, and committed once the setup has succeeded.
-        let claim = match dir {
-            Some(dir) => {
-                let mode = match (resume.is_some(), overwrite) {
-                    (true, _) => Mode::Resume,
-                    (false, true) => Mode::Overwrite,
-                    (false, false) => Mode::Fresh,
-                };
-                Some(Claim::take(dir, mode)?)
-            }
-            None => None,
+        let mode = match (resume.is_some(), overwrite) {
+            (true, _) => Mode::Resume,
+            (false, true) => Mode::Overwrite,
+            (false, false) => Mode::Fresh,
         };
-        if let Some(report) = &report {
-            for line in report.lines() {
-                observer.on_plan_line(&line);
-                tracing::info!("{line}");
-            }
-        }
-        let checkpoint = match (resume, dir) {
+        let resume = match (resume, dir) {
             (Some(newton_changed), Some(dir)) => {
-                let path = dir.join(checkpoint::FILE);
-                let c = Checkpoint::read(&path)?;
-                c.check_job(job, &path, newton_changed)?;
-                tracing::info!(step = c.solver.step, "resuming from {}", path.display());
-                Some(c)
+                Some(ResumeFrom { file: dir.join(checkpoint::FILE), newton_changed })
             }
             _ => None,
         };
-        // Everything that can fail before the first step (the model, the snapshot ids, the
-        // workers and their assemblies) comes before the writer opens the run directory: a
-        // failed setup leaves a previous run's files as they were.
-        let setup = std::time::Instant::now();
-        let mut solver = Solver::new(job.model()?, job.solver_settings()?)?;
-        let stages = job.stages()?;
-        let ids = gauss_point_ids(&solver);
-        let watched = if snapshots {
-            resolve_snapshot_ids(&job.output.snapshots, &solver.gauss().counts())?
-        } else {
-            Vec::new()
-        };
-        let saved = checkpoint.as_ref().map(Checkpoint::assembly_states);
-        let (mut material, n_workers, specimens) = match material {
-            None => {
-                let built = material_for(job, &workers, &solver.model().mesh, &ids, saved)?;
-                (built.material, built.workers, built.specimens)
-            }
-            Some(build) => {
-                let mut m = build(&ids)?;
-                if let Some(states) = saved {
-                    m.restore_states(states).map_err(cosdem_fem::Error::from)?;
-                }
-                (m, 0, None)
-            }
-        };
-        // The setup has succeeded: the run directory is the run's from here on.
-        let _lock = match (claim, dir) {
-            (Some(claim), Some(dir)) => {
-                let lock = claim.commit()?;
-                observer.on_dir(dir).map_err(RunError::Observer)?;
-                let origin = origin.unwrap_or_else(Origin::of_process);
-                let resumed_at = checkpoint.as_ref().map(|c| c.solver.step);
-                provenance::record(dir, self.job, &origin, resumed_at)?;
-                if let Some(report) = &report {
-                    super::write_accuracy_report(report, dir)?;
-                }
-                Some(lock)
-            }
-            _ => None,
-        };
-        let mut writer = match (dir, &checkpoint) {
-            (Some(dir), Some(c)) => Some(RunWriter::resume(dir, run_settings(job), c.solver.step)?),
-            (Some(dir), None) => Some(RunWriter::create(dir, run_settings(job))?),
-            (None, _) => None,
-        };
-        if let Some(w) = writer.as_mut() {
-            w.add_setup_time(setup.elapsed());
+        let Prepared {
+            job,
+            mut solver,
+            stages,
+            mut material,
+            checkpoint,
+            mut writer,
+            lock,
+            watched,
+        } = Setup {
+            job: self.job,
+            dir,
+            mode,
+            resume,
+            workers: &workers,
+            material,
+            max_memory,
+            origin,
+            snapshots,
+            loads: Loads::Job,
         }
+        .prepare(observer)?;
+        let _lock = lock;
+        let job = &job;
         if let Some(c) = checkpoint {
             solver.restore(c.solver)?;
             let at = &stages[(solver.stage() as usize).min(stages.len() - 1)];
@@ -345,9 +292,6 @@ impl<'a> Run<'a> {
                 "stopped by Ctrl-C or SIGTERM",
             ),
         };
-        if let Some(w) = writer.as_mut().filter(|_| !job.region.is_empty()) {
-            w.set_regions(job, &job.element_materials(&solver.model().mesh)?);
-        }
         let mut tap;
         let material: &mut dyn Material = match writer.as_mut() {
             Some(w) if snapshots => {
@@ -356,12 +300,6 @@ impl<'a> Run<'a> {
             }
             _ => material.as_mut(),
         };
-        if let Some(w) = writer.as_mut() {
-            w.set_workers(n_workers);
-            if let Some(report) = specimens {
-                w.set_specimens(report);
-            }
-        }
         observer.on_start().map_err(RunError::Observer)?;
         let (outcome, reached_max) = {
             let hook = StepHook { writer: writer.as_mut(), observer: &mut *observer };

@@ -15,10 +15,12 @@ pub mod in_situ;
 pub mod material;
 /// What a caller sees of a run ([`RunObserver`]) and the per-step hook.
 pub mod observer;
+/// What a run does before its first step, shared by the driver and the stepper.
+pub(crate) mod setup;
 
 pub use driver::{BuildMaterial, Ending, Run, RunOutcome};
 pub use material::{Built, SpecimenReport, material_for};
-pub use observer::{HookError, RunObserver};
+pub use observer::{HookError, PROGRESS_TEMPLATE, RunObserver, step_message};
 
 use crate::output::run_dir::{RunSettings, Summary};
 use cosdem_common::GaussPointId;
@@ -76,6 +78,47 @@ pub enum RunError {
     /// The caller's [`RunObserver`] failed.
     #[error(transparent)]
     Observer(HookError),
+    /// A stage given to a [`crate::stepper::Stepper`] could not be solved; the stepper went
+    /// back to where the stage started and can go on.
+    #[error(
+        "stage {index} ({name:?}) failed: {source}; the stepper is back at step {step}, where the stage started"
+    )]
+    StageFailed {
+        /// The stage's index among the caller's stages (0-based).
+        index: usize,
+        /// Its name.
+        name: String,
+        /// The committed step the stepper is back at.
+        step: u64,
+        /// Why the stage failed (boxed: a [`RunError`] stays small).
+        #[source]
+        source: Box<cosdem_fem::Error>,
+    },
+    /// A name a stepper's query gave that the mesh or the field does not have.
+    #[error("no {what} {value:?} (known: {known})")]
+    Unknown {
+        /// What was asked for (`node set`, `component`).
+        what: &'static str,
+        /// The name given.
+        value: String,
+        /// The names there are.
+        known: String,
+    },
+    /// A stage given to a stepper as text could not be read.
+    #[error("stage {text:?}: {reason}")]
+    StageText {
+        /// The text given.
+        text: String,
+        /// What is wrong with it (the key named).
+        reason: String,
+    },
+    /// A stepper whose failed stage could not be undone (its workers gone, its run directory
+    /// unwritable) can go on no more.
+    #[error("the stepper cannot go on: {reason}")]
+    Broken {
+        /// What failed, and why it could not be undone.
+        reason: String,
+    },
 }
 
 /// The job to run: `job` itself (unchanged, bit for bit) when it has no `accuracy` key, else

@@ -46,6 +46,25 @@ pub trait RunObserver {
     fn on_end(&mut self) {}
 }
 
+/// The indicatif template of the progress bars of `cosdem run` and the Python package: the
+/// elapsed time, the bar and percentage of the load factor, the ETA, [`step_message`].
+pub const PROGRESS_TEMPLATE: &str = "[{elapsed_precise}] {bar:30} {percent:>3}% ETA {eta} {msg}";
+
+/// The progress line of a committed step that `record` has recorded, `seconds` into the run
+/// (what the CLI's and the Python package's progress bars show): step, displacement and load
+/// of the curve, Newton iterations, DEM relaxation steps per second.
+pub fn step_message(report: &StepReport, record: &RunWriter, seconds: f64) -> String {
+    let sum = record.summary();
+    format!(
+        "step {} d={:.4e} m load={:.4e} N it={} DEM {:.2e} relax-steps/s",
+        report.step,
+        sum.displacement,
+        record.curve().last().map_or(0.0, |p| p.1),
+        report.iterations,
+        sum.dem_steps as f64 / seconds.max(1e-9)
+    )
+}
+
 /// The observer of a run whose caller watches nothing.
 pub(crate) struct Silent;
 

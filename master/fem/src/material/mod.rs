@@ -92,7 +92,8 @@ pub trait Material: Send {
     }
 
     /// Puts back committed states saved by [`Material::committed_states`] (resume from a
-    /// checkpoint). Stateless materials ignore them.
+    /// checkpoint, or a caller going back to states it saved before committing more steps:
+    /// the assemblies of those points are replaced). Stateless materials ignore them.
     fn restore_states(&mut self, states: Vec<AssemblyState>) -> Result<(), MaterialError> {
         let _ = states;
         Ok(())
