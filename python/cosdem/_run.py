@@ -10,6 +10,7 @@ import numpy as np
 
 from . import _native
 from ._arrays import array, arrays
+from ._errors import ResultsError
 
 
 class Run:
@@ -63,7 +64,7 @@ class Run:
             return int(step)
         steps = self.saved_steps
         if not steps:
-            raise _errors().ResultsError(f"{self.dir}: no step has saved fields yet")
+            raise ResultsError(f"{self.dir}: no step has saved fields yet")
         return steps[-1]
 
     def gauss(self, step: Optional[int] = None) -> Dict[str, np.ndarray]:
@@ -107,8 +108,3 @@ def open_run(dir: Union[str, "os.PathLike[str]"]) -> Run:
     """Opens a run directory (finished, stopped or still being written)."""
     return Run(dir)
 
-
-def _errors() -> Any:
-    from . import _errors as errors
-
-    return errors

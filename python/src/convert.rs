@@ -1,6 +1,6 @@
 //! Values between Python and the job's TOML: a `dict` given to `cosdem.Job(...)` becomes a
-//! TOML table (read by the job file's own parser), and TOML or JSON values (a job's table, a
-//! run's `summary.json`) become plain Python objects.
+//! TOML table (read by the job file's own parser), and JSON values (a job's table through
+//! serde, a run's `summary.json`) become plain Python objects.
 
 use crate::errors::job_error;
 use pyo3::prelude::*;
@@ -88,28 +88,6 @@ fn value_from_py(py: Python<'_>, value: &Bound<'_, PyAny>, at: &str) -> PyResult
 
 fn type_name(value: &Bound<'_, PyAny>) -> String {
     value.get_type().name().map_or_else(|_| "value".into(), |n| n.to_string())
-}
-
-/// A TOML value as a Python object (tables as `dict`, arrays as `list`, datetimes as `str`).
-pub fn toml_to_py<'py>(py: Python<'py>, value: &toml::Value) -> PyResult<Bound<'py, PyAny>> {
-    Ok(match value {
-        toml::Value::String(s) => s.into_pyobject(py)?.into_any(),
-        toml::Value::Integer(i) => i.into_pyobject(py)?.into_any(),
-        toml::Value::Float(f) => f.into_pyobject(py)?.into_any(),
-        toml::Value::Boolean(b) => PyBool::new(py, *b).to_owned().into_any(),
-        toml::Value::Datetime(d) => d.to_string().into_pyobject(py)?.into_any(),
-        toml::Value::Array(a) => {
-            PyList::new(py, a.iter().map(|v| toml_to_py(py, v)).collect::<PyResult<Vec<_>>>()?)?
-                .into_any()
-        }
-        toml::Value::Table(t) => {
-            let dict = PyDict::new(py);
-            for (k, v) in t {
-                dict.set_item(k, toml_to_py(py, v)?)?;
-            }
-            dict.into_any()
-        }
-    })
 }
 
 /// A JSON value as a Python object (`null` as `None`).

@@ -1,7 +1,7 @@
 //! `cosdem.Job`: a job read from a TOML file or a dict, validated as the CLI validates it, and
 //! run into a run directory.
 
-use crate::convert::{table_from_py, toml_to_py};
+use crate::convert::{json_to_py, table_from_py};
 use crate::errors::job_error;
 use crate::running::{RunOptions, run};
 use cosdem_job::Job;
@@ -41,7 +41,7 @@ impl PyJob {
     /// The job's tables as written (defaults not filled in), as a dict.
     fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let table: toml::Table = toml::from_str(&self.text).map_err(|e| job_error(py, e))?;
-        toml_to_py(py, &toml::Value::Table(table))
+        json_to_py(py, &serde_json::to_value(table).map_err(|e| job_error(py, e))?)
     }
 
     /// The TOML text of the job.
