@@ -27,17 +27,32 @@ pub(crate) struct RveArgs {
     /// Stress-control tolerance, relative to the pressure.
     #[arg(long, default_value_t = 1e-3)]
     tolerance: f64,
-    /// Output directory (default `runs/<job stem>-rve-<path>`).
+    /// Replaces the random packing's seed: another specimen of the same material (the
+    /// scatter of a calibration over seeds).
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Output directory (default `runs/<job stem>-rve-<path>`, `-seed<N>` appended with
+    /// `--seed`).
     #[arg(long)]
     out: Option<PathBuf>,
 }
 
 pub(crate) fn rve(args: RveArgs) -> Result<()> {
     use cosdem_app::rve::{RvePath, RveSettings, drive, report, table};
-    let job = Job::load(&args.job)?;
-    let MaterialSection::Dem { assembly } = &job.material else {
+    let mut job = Job::load(&args.job)?;
+    let MaterialSection::Dem { assembly } = &mut job.material else {
         anyhow::bail!("{}: `cosdem rve` needs [material] kind = \"dem\"", args.job.display());
     };
+    if let Some(new) = args.seed {
+        let cosdem_dem::PackingSpec::Random { seed, .. } = &mut assembly.packing else {
+            anyhow::bail!(
+                "--seed {new}: the job's packing is `{}`; only a random packing has a seed",
+                assembly.packing.kind()
+            );
+        };
+        *seed = new;
+    }
+    let assembly = &*assembly;
     let path = match args.path.as_str() {
         "biaxial" => RvePath::Biaxial,
         "isotropic" => RvePath::Isotropic,
@@ -65,7 +80,8 @@ pub(crate) fn rve(args: RveArgs) -> Result<()> {
     };
     settings.validate()?;
     let dir = args.out.clone().unwrap_or_else(|| {
-        Path::new("runs").join(format!("{}-rve-{}", stem(&args.job), settings.path.name()))
+        let seed = args.seed.map(|s| format!("-seed{s}")).unwrap_or_default();
+        Path::new("runs").join(format!("{}-rve-{}{seed}", stem(&args.job), settings.path.name()))
     });
     let t0 = Instant::now();
     let mut a = cosdem_dem::Assembly::new(assembly)?;
@@ -92,7 +108,7 @@ pub(crate) fn rve(args: RveArgs) -> Result<()> {
     writer.finish(t0.elapsed().as_secs_f64())?;
     let s = writer.summary();
     println!(
-        "peak friction angle {:.2} deg at step {} (strain {:.4e}, q = {:.4e} Pa), dilatancy at peak {:.2} deg, max {:.2} deg; final friction angle {:.2} deg, volumetric strain {:.4e}; {} DEM steps, {:.1} s",
+        "peak friction angle {:.2} deg at step {} (strain {:.4e}, q = {:.4e} Pa), dilatancy at peak {:.2} deg, max {:.2} deg; final friction angle {:.2} deg, volumetric strain {:.4e}; from step {}: friction angle {:.2} deg, dilatancy {:.2} deg (the critical state if the dilatancy is near 0); {} DEM steps, {:.1} s",
         s.peak_friction_angle,
         s.peak_step,
         s.peak_strain,
@@ -101,6 +117,9 @@ pub(crate) fn rve(args: RveArgs) -> Result<()> {
         s.max_dilatancy_angle,
         s.final_friction_angle,
         s.final_volumetric_strain,
+        s.critical_state_from_step,
+        s.critical_state_friction_angle,
+        s.critical_state_dilatancy_angle,
         s.dem_steps,
         s.wall_seconds
     );

@@ -270,7 +270,7 @@ fn steps_key(job: &Job, steps: f64) -> String {
 fn packing_keys(p: &PackingSpec) -> Vec<String> {
     let k = |name: &str, v: f64| format!("material.assembly.packing.{name} = {v:?}");
     match p {
-        PackingSpec::Hexagonal { radius, side } => vec![k("side", *side), k("radius", *radius)],
+        PackingSpec::Hexagonal { radius, side, .. } => vec![k("side", *side), k("radius", *radius)],
         PackingSpec::Random { radii, side, .. } if !radii.is_empty() => {
             vec![
                 format!("material.assembly.packing.radii = [{} radii]", radii.len()),

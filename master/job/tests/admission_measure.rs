@@ -114,7 +114,7 @@ fn measured_figures() {
             "{what}: {measured} vs {constant}"
         );
     };
-    let hex = |side| PackingSpec::Hexagonal { radius: 0.005, side };
+    let hex = |side| PackingSpec::hexagonal(0.005, side);
     let random = |side| PackingSpec::Random {
         r_min: 0.004,
         r_max: 0.006,

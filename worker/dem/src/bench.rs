@@ -28,11 +28,8 @@ pub fn hexagonal(n: usize) -> Result<Assembly> {
 pub fn hexagonal_with(n: usize, contact: ContactParams) -> Result<Assembly> {
     let r = 0.005;
     let side = (n as f64 * 2.0 * 3f64.sqrt() * r * r).sqrt() + 2.0 * r;
-    let spec = AssemblySpec {
-        packing: PackingSpec::Hexagonal { radius: r, side },
-        contact,
-        ..Default::default()
-    };
+    let spec =
+        AssemblySpec { packing: PackingSpec::hexagonal(r, side), contact, ..Default::default() };
     Assembly::new(&spec)
 }
 
@@ -132,10 +129,7 @@ pub fn pair_cost(n: usize, passes: usize, one_at_a_time: bool) -> Result<(usize,
 /// Full relaxation of the 0.0784 m^2 assembly (r = 5 mm) after a `1e-3` compressive strain
 /// increment: returns (discs, steps, converged, wall seconds).
 pub fn relaxation() -> Result<(usize, u64, bool, f64)> {
-    let spec = AssemblySpec {
-        packing: PackingSpec::Hexagonal { radius: 0.005, side: 0.28 },
-        ..Default::default()
-    };
+    let spec = AssemblySpec { packing: PackingSpec::hexagonal(0.005, 0.28), ..Default::default() };
     let mut a = Assembly::new(&spec)?;
     let target = MacroDeformation::from_gradient([[0.0, 0.0], [0.0, -1e-3]], 0.0, [0.0; 2]);
     let t0 = Instant::now();

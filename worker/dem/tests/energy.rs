@@ -77,7 +77,7 @@ fn time_step_is_stable_over_six_orders_of_stiffness() {
             for kr in [1e-2, 1e4] {
                 for r in [1e-4, 0.1] {
                     let mut spec = AssemblySpec {
-                        packing: PackingSpec::Hexagonal { radius: r, side: 10.0 * r },
+                        packing: PackingSpec::hexagonal(r, 10.0 * r),
                         // Penalty springs 10 k_n and 10 k_r as at the paper's V = 0.01 m^2, so
                         // the prestress reaches the discs whatever the stiffness.
                         boundary: cosdem_dem::BoundarySpec::Penalty {

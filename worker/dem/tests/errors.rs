@@ -13,11 +13,11 @@ fn err_of(spec: &AssemblySpec) -> String {
 #[test]
 fn bad_specs_name_the_field() {
     let mut s = hex_spec(0.1, penalty());
-    s.packing = PackingSpec::Hexagonal { radius: -0.005, side: 0.1 };
+    s.packing = PackingSpec::hexagonal(-0.005, 0.1);
     let e = err_of(&s);
     assert!(e.contains("packing.radius") && e.contains("-0.005"), "{e}");
 
-    s.packing = PackingSpec::Hexagonal { radius: 0.005, side: 0.02 };
+    s.packing = PackingSpec::hexagonal(0.005, 0.02);
     assert!(err_of(&s).contains("packing.side"));
 
     let mut s = hex_spec(0.1, penalty());

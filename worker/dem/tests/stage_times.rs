@@ -6,10 +6,7 @@ use cosdem_dem::integrate::StageTimes;
 use cosdem_dem::{Assembly, AssemblySpec, PackingSpec};
 
 fn assembly() -> Assembly {
-    let spec = AssemblySpec {
-        packing: PackingSpec::Hexagonal { radius: 0.005, side: 0.1 },
-        ..Default::default()
-    };
+    let spec = AssemblySpec { packing: PackingSpec::hexagonal(0.005, 0.1), ..Default::default() };
     Assembly::new(&spec).unwrap()
 }
 

@@ -10,10 +10,8 @@ use tonic::{Code, Request};
 
 /// The committed state of a small hexagonal assembly (about 30 discs), as ExportState sends it.
 fn state() -> Vec<u8> {
-    let spec = AssemblySpec {
-        packing: PackingSpec::Hexagonal { radius: 0.005, side: 0.04 },
-        ..AssemblySpec::default()
-    };
+    let spec =
+        AssemblySpec { packing: PackingSpec::hexagonal(0.005, 0.04), ..AssemblySpec::default() };
     Assembly::new(&spec).unwrap().to_bytes()
 }
 

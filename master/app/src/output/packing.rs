@@ -122,10 +122,8 @@ mod tests {
     /// one vertex and one radius per disc.
     #[test]
     fn exported_states_read_back() {
-        let spec = AssemblySpec {
-            packing: PackingSpec::Hexagonal { radius: 0.005, side: 0.05 },
-            ..Default::default()
-        };
+        let spec =
+            AssemblySpec { packing: PackingSpec::hexagonal(0.005, 0.05), ..Default::default() };
         let a = Assembly::new(&spec).unwrap();
         let bytes = a.to_bytes();
         let id = GaussPointId { element: 3, point: 1 };

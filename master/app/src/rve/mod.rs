@@ -274,6 +274,11 @@ fn controlled_step(
     lateral(assembly, settings, step, m, c, t[i][i])
 }
 
+/// Largest change of the controlled strain in one correction of [`lateral`], in load-step
+/// increments: dilatant granular specimens widen by at most about one increment per step,
+/// so a correction beyond a few is a secant gone flat, not the answer.
+pub const MAX_MOVE: f64 = 4.0;
+
 /// Isotropic consolidation to `settings.pressure` from the reference state: `s_xx = s_yy =
 /// -p`, both normal strains adjusted by Newton iterations with the 2 x 2 normal block of the
 /// assembly's tangent (a packing need not be isotropic, so the strains may differ).
@@ -321,7 +326,11 @@ fn consolidate(assembly: &mut Assembly, settings: &RveSettings) -> Result<RveRow
 
 /// Newton-secant iteration on the controlled component: the first correction uses the
 /// tangent `c_ii`, later ones the secant through the last two iterates (the paper tangent
-/// ignores sliding, so past the elastic range the secant is the better slope).
+/// ignores sliding, so past the elastic range the secant is the better slope). Safeguarded:
+/// a correction moves the component by at most [`MAX_MOVE`] increments, and once iterates
+/// on both sides of the target are known it stays between them (bisecting when the secant
+/// points outside). Past a peak a soft, noisy response gives near-zero secants whose
+/// corrections were unbounded: a 147-disc specimen at 20 kPa reached det F < 0 at step 74.
 fn lateral(
     assembly: &mut Assembly,
     settings: &RveSettings,
@@ -336,6 +345,9 @@ fn lateral(
     let mut prev: Option<(f64, f64)> = None;
     let mut best: Option<(MacroDeformation, MicroResponse, f64, u32)> = None;
     let mut slope0 = c_ii;
+    let max_move = MAX_MOVE * settings.increment.abs();
+    // The largest iterate below the target and the smallest above it.
+    let (mut below, mut above) = (f64::NEG_INFINITY, f64::INFINITY);
     for it in 1..=settings.max_iterations {
         let r = solve(assembly, &m, step)?;
         let f = r.stress[i] - c.target;
@@ -346,6 +358,11 @@ fn lateral(
             break;
         }
         let e = *component(&mut m, i);
+        if f < 0.0 {
+            below = below.max(e);
+        } else {
+            above = above.min(e);
+        }
         if slope0 <= 0.0 || !slope0.is_finite() {
             slope0 = r.tangent[i][i];
         }
@@ -360,7 +377,15 @@ fn lateral(
             break;
         }
         prev = Some((e, f));
-        *component(&mut m, i) = e - f / slope;
+        let mut next = e - (f / slope).clamp(-max_move, max_move);
+        if below < above
+            && above.is_finite()
+            && below.is_finite()
+            && !(below < next && next < above)
+        {
+            next = 0.5 * (below + above);
+        }
+        *component(&mut m, i) = next;
     }
     let (m, r, f, it) = best.expect("at least one iteration");
     let r = if assembly.trial().is_some_and(|s| s.target == m) {

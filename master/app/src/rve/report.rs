@@ -67,11 +67,19 @@ pub fn volumetric_strain(m: &MacroDeformation) -> f64 {
     m.det() - 1.0
 }
 
-/// Dilatancy angle in degrees of the step from `a` to `b` (NaN for a zero increment).
+/// Dilatancy angle in degrees of the step from `a` to `b` (NaN for a zero increment), from
+/// the strain increment in the current configuration: the symmetric part of
+/// `dF F_mid^-1`, `F_mid` the mean of the two gradients (exact for any step of a constant
+/// principal stretch rate along fixed axes, e.g. `F = diag(l, 1/l)`: no area change, zero
+/// angle however large the strain). The increment of `F` itself (`dF`, what this used
+/// before 2026-12-06) reads an isochoric step at 20 % strain as dilating by 12-18 degrees.
 pub fn dilatancy_angle(a: &MacroDeformation, b: &MacroDeformation) -> f64 {
-    let ga = a.gradient();
-    let gb = b.gradient();
-    let d = |i: usize, j: usize| gb[i][j] - ga[i][j];
+    let (fa, fb) = (a.f, b.f);
+    let mid = |i: usize, j: usize| 0.5 * (fa[i][j] + fb[i][j]);
+    let det = mid(0, 0) * mid(1, 1) - mid(0, 1) * mid(1, 0);
+    let inv = [[mid(1, 1) / det, -mid(0, 1) / det], [-mid(1, 0) / det, mid(0, 0) / det]];
+    let df = |i: usize, j: usize| fb[i][j] - fa[i][j];
+    let d = |i: usize, j: usize| df(i, 0) * inv[0][j] + df(i, 1) * inv[1][j];
     let (exx, eyy, exy) = (d(0, 0), d(1, 1), 0.5 * (d(0, 1) + d(1, 0)));
     let mean = 0.5 * (exx + eyy);
     let rad = (0.25 * (exx - eyy) * (exx - eyy) + exy * exy).sqrt();
@@ -105,6 +113,15 @@ pub struct RveSummary {
     pub final_friction_angle: f64,
     /// Volumetric strain of the last step.
     pub final_volumetric_strain: f64,
+    /// First step of the path's last quarter (at least its last two steps), over which the
+    /// critical state is read.
+    pub critical_state_from_step: u64,
+    /// Mean friction angle over the last quarter (degrees): the critical-state friction
+    /// angle once the specimen deforms at constant volume and stress.
+    pub critical_state_friction_angle: f64,
+    /// Dilatancy angle of the last quarter as one increment (degrees): near zero when the
+    /// last quarter is at the critical state (check it before quoting the friction angle).
+    pub critical_state_dilatancy_angle: f64,
     /// DEM steps of all accepted relaxations.
     pub dem_steps: u64,
     /// Steps whose controlled stress missed its tolerance.
@@ -119,6 +136,8 @@ pub struct RveWriter {
     rows: CsvWriter,
     tangent: CsvWriter,
     last: Option<RveRow>,
+    /// Every step's friction angle and deformation (the critical state's window).
+    history: Vec<(u64, f64, MacroDeformation)>,
     summary: RveSummary,
     tolerance: f64,
 }
@@ -144,7 +163,8 @@ impl RveWriter {
         let tangent = CsvWriter::create(&dir.join("tangent.csv"), &refs)?;
         let summary =
             RveSummary { peak_friction_angle: f64::NAN, max_dilatancy_angle: f64::NAN, ..summary };
-        Ok(Self { dir: dir.to_path_buf(), rows, tangent, last: None, summary, tolerance })
+        let history = Vec::new();
+        Ok(Self { dir: dir.to_path_buf(), rows, tangent, last: None, history, summary, tolerance })
     }
 
     /// Appends one state to both CSV files and updates the summary.
@@ -193,6 +213,8 @@ impl RveWriter {
         }
         s.final_friction_angle = phi;
         s.final_volumetric_strain = ev;
+        self.history.push((r.step, phi, *m));
+        critical_state(&self.history, s);
         self.last = Some(r.clone());
         Ok(())
     }
@@ -213,9 +235,46 @@ impl RveWriter {
     }
 }
 
+/// The critical state read off the last quarter of `history` (the loading steps, not the
+/// initial state; at least two steps): the mean friction angle and the dilatancy angle of
+/// the quarter as one increment. NaN before there are two loading steps.
+fn critical_state(history: &[(u64, f64, MacroDeformation)], s: &mut RveSummary) {
+    let loading = history.len().saturating_sub(1);
+    s.critical_state_friction_angle = f64::NAN;
+    s.critical_state_dilatancy_angle = f64::NAN;
+    if loading < 2 {
+        return;
+    }
+    let n = (loading / 4).max(2);
+    let window = &history[history.len() - n..];
+    let before = &history[history.len() - n - 1];
+    s.critical_state_from_step = window[0].0;
+    s.critical_state_friction_angle = window.iter().map(|h| h.1).sum::<f64>() / n as f64;
+    s.critical_state_dilatancy_angle = dilatancy_angle(&before.2, &window[n - 1].2);
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The critical state of a made-up history of 8 loading steps: the last quarter is its
+    /// last 2 steps (from step 7), the friction angle their mean, the dilatancy angle that of
+    /// steps 6 to 8 as one increment (`F = diag(l, 1/l)`, no area change: 0).
+    #[test]
+    fn the_critical_state_is_the_last_quarter() {
+        let at = |k: u64| {
+            let l = 1.0 + 1e-3 * k as f64;
+            MacroDeformation::from_gradient([[l - 1.0, 0.0], [0.0, 1.0 / l - 1.0]], 0.0, [0.0; 2])
+        };
+        let history: Vec<_> = (0..=8).map(|k| (k, 20.0 + k as f64, at(k))).collect();
+        let mut s = RveSummary::default();
+        critical_state(&history[..2], &mut s);
+        assert!(s.critical_state_friction_angle.is_nan());
+        critical_state(&history, &mut s);
+        assert_eq!(s.critical_state_from_step, 7);
+        assert_eq!(s.critical_state_friction_angle, 27.5);
+        assert!(s.critical_state_dilatancy_angle.abs() < 1e-9);
+    }
 
     /// Closed forms: a stress state with sigma_1 = 3 sigma_3 gives sin(phi) = 1/2 (30 deg);
     /// a strain increment with no area change gives psi = 0, and de_1 = 2e-3, de_3 = -1e-3 gives
@@ -232,12 +291,23 @@ mod tests {
         assert!((a - 300.0).abs() < 1e-12 && (b - 100.0).abs() < 1e-12);
         assert!(friction_angle(&[1.0, 1.0, 0.0, 0.0, 0.0, 0.0]).is_nan());
         let id = MacroDeformation::IDENTITY;
-        // e_yy = -1e-3, e_xx = +1e-3: no volume change, psi = 0 (up to the rounding of
-        // 1 +- 1e-3 in F, 1e-16 against 1e-3 strain: 1e-13 rad).
-        let b = MacroDeformation::from_gradient([[1e-3, 0.0], [0.0, -1e-3]], 0.0, [0.0; 2]);
+        // F = diag(1.001, 1/1.001): no area change, psi = 0 (up to the rounding of F,
+        // 1e-16 against 1e-3 strain: 1e-13 rad).
+        let b =
+            MacroDeformation::from_gradient([[1e-3, 0.0], [0.0, 1.0 / 1.001 - 1.0]], 0.0, [0.0; 2]);
         assert!(dilatancy_angle(&id, &b).abs() < 1e-10);
-        // e_yy = -1e-3, e_xx = +2e-3: sin(psi) = (2 - 1) / (2 + 1) = 1/3, dilation.
+        // e_yy = -1e-3, e_xx = +2e-3 from the identity: the current-configuration increments
+        // are d_xx = 2e-3 / (1 + 1e-3), d_yy = -1e-3 / (1 - 0.5e-3) (F_mid = diag(1.001,
+        // 0.9995)), sin(psi) = (d_xx + d_yy) / (d_xx - d_yy), dilation (about 1/3).
         let b = MacroDeformation::from_gradient([[2e-3, 0.0], [0.0, -1e-3]], 0.0, [0.0; 2]);
-        assert!((dilatancy_angle(&id, &b) - (1.0f64 / 3.0).asin().to_degrees()).abs() < 1e-9);
+        let (dxx, dyy): (f64, f64) = (2e-3 / 1.001, -1e-3 / 0.9995);
+        let want = ((dxx + dyy) / (dxx - dyy)).asin().to_degrees();
+        assert!((dilatancy_angle(&id, &b) - want).abs() < 1e-9);
+        // A large isochoric step, diag(1.2, 1/1.2) to diag(1.25, 1/1.25): zero angle (the
+        // increment of F itself would give asin(0.0167 / 0.0833) = 11.5 degrees).
+        let at = |l: f64| {
+            MacroDeformation::from_gradient([[l - 1.0, 0.0], [0.0, 1.0 / l - 1.0]], 0.0, [0.0; 2])
+        };
+        assert!(dilatancy_angle(&at(1.2), &at(1.25)).abs() < 1e-9);
     }
 }

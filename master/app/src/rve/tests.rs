@@ -7,10 +7,8 @@ use super::*;
 use cosdem_dem::{AssemblySpec, PackingSpec};
 
 fn tiny() -> Assembly {
-    let spec = AssemblySpec {
-        packing: PackingSpec::Hexagonal { radius: 0.005, side: 0.05 },
-        ..AssemblySpec::default()
-    };
+    let spec =
+        AssemblySpec { packing: PackingSpec::hexagonal(0.005, 0.05), ..AssemblySpec::default() };
     Assembly::new(&spec).unwrap()
 }
 

@@ -99,7 +99,7 @@ pub type BenchResult<T> = std::result::Result<T, Box<dyn std::error::Error + Sen
 pub fn hexagonal_spec(discs: usize) -> AssemblySpec {
     let r = 0.005;
     let side = (discs as f64 * 2.0 * 3f64.sqrt() * r * r).sqrt() + 2.0 * r;
-    AssemblySpec { packing: PackingSpec::Hexagonal { radius: r, side }, ..Default::default() }
+    AssemblySpec { packing: PackingSpec::hexagonal(r, side), ..Default::default() }
 }
 
 /// The trial deformation of iteration `k` (1-based): `e_yy = -1e-4 k`.

@@ -125,7 +125,7 @@ pub fn job_for_size(job: &Job, size: f64, radius: Option<f64>) -> Result<Job> {
     };
     let side = size.sqrt();
     match &mut assembly.packing {
-        PackingSpec::Hexagonal { radius: r, side: s } => {
+        PackingSpec::Hexagonal { radius: r, side: s, .. } => {
             *s = side;
             if let Some(new) = radius {
                 *r = new;

@@ -16,12 +16,21 @@ pub(super) fn new(spec: &AssemblySpec) -> Result<Assembly> {
     spec.validate()?;
     let law = Law::from_params(&spec.contact);
     match &spec.packing {
-        PackingSpec::Hexagonal { radius, side } => {
+        PackingSpec::Hexagonal { radius, side, .. } => {
+            let lattice = spec.packing.lattice().unwrap_or_default();
             let p = match spec.boundary {
-                BoundarySpec::Penalty { .. } => hexagonal::square(*radius, *side),
-                BoundarySpec::Periodic => hexagonal::periodic(*radius, *side),
+                BoundarySpec::Penalty { .. } => hexagonal::square(*radius, *side, lattice),
+                BoundarySpec::Periodic => hexagonal::periodic(*radius, *side, lattice),
             };
-            from_packing(spec, law, p)
+            let mut a = from_packing(spec, law, p)?;
+            // An overlapping lattice is prestressed: in a periodic cell it is in equilibrium
+            // by symmetry; cut to a square, the boundary springs' rest points balance it.
+            if let BoundarySpec::Penalty { eps_f, eps_c } = spec.boundary
+                && lattice.overlap > 0.0
+            {
+                prestress_reference(&mut a, eps_f, eps_c);
+            }
+            Ok(a)
         }
         PackingSpec::Random { .. } => {
             // The specimen is the material: generated with fixed relaxation settings, so that

@@ -3,6 +3,7 @@
 
 use super::*;
 use crate::packing::hexagonal;
+use crate::spec::Lattice;
 
 const OPT: ReadOptions = ReadOptions { density: 2650.0, periodic: false };
 
@@ -48,7 +49,10 @@ fn write_then_read_gives_the_same_bits() {
 fn a_hexagonal_packing_keeps_its_solid_fraction() {
     let hex = std::f64::consts::PI / (2.0 * 3f64.sqrt());
     let r = 0.005;
-    for (p, tol) in [(hexagonal::periodic(r, 0.2), 1e-12), (hexagonal::square(r, 0.2), 0.1)] {
+    for (p, tol) in [
+        (hexagonal::periodic(r, 0.2, Lattice::default()), 1e-12),
+        (hexagonal::square(r, 0.2, Lattice::default()), 0.1),
+    ] {
         for text in [write_yade(&p), write_lammps(&p, 2650.0)] {
             let format =
                 if text.starts_with('#') { PackingFormat::Yade } else { PackingFormat::Lammps };

@@ -42,7 +42,7 @@ mod tangent;
 
 pub use boundary::BoundarySpec;
 pub use contact::{ContactParams, NormalModel, RollingModel, TangentialModel};
-pub use packing::{MAX_DISCS, PackingSpec};
+pub use packing::{Lattice, LatticeOrientation, MAX_DISCS, MAX_LATTICE_OVERLAP, PackingSpec};
 pub use relaxation::{
     Criterion, Driver, FIRE_CEILING, MAX_RELAXATION_STEPS, MAX_SUBSTEPS, RelaxationSpec,
 };

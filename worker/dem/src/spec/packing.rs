@@ -19,6 +19,13 @@ pub enum PackingSpec {
         radius: f64,
         /// Side of the reference square (m). Default 0.1 m (V = 0.01 m^2, about 100 discs).
         side: f64,
+        /// Which way the lattice runs: rows along x (the default) or turned by 90 degrees.
+        #[serde(default, skip_serializing_if = "LatticeOrientation::is_rows")]
+        orientation: LatticeOrientation,
+        /// Initial overlap of neighbours, a fraction of the diameter: centres `2 r (1 -
+        /// overlap)` apart, in `[0, 0.05]`. Default 0 (touching, no force).
+        #[serde(default, skip_serializing_if = "is_zero")]
+        overlap: f64,
     },
     /// Seeded random polydisperse packing brought to an isotropic confining stress.
     Random {
@@ -64,9 +71,46 @@ pub enum PackingSpec {
     },
 }
 
+/// Which way a hexagonal lattice runs in its square.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LatticeOrientation {
+    /// Rows of touching discs along x: contact families at 0, 60 and 120 degrees. Under a
+    /// vertical load without lateral stress its 60-degree contacts slide (it cannot stand
+    /// below a lateral to axial stress ratio of about 0.035).
+    #[default]
+    Rows,
+    /// Turned by 90 degrees: columns along y, contact families at 90, 30 and 150 degrees. A
+    /// vertical load is carried by the columns, at any lateral stress down to zero.
+    Columns,
+}
+
+impl LatticeOrientation {
+    fn is_rows(&self) -> bool {
+        *self == LatticeOrientation::Rows
+    }
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
+}
+
+/// How a hexagonal packing's lattice is laid: its orientation and initial overlap.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Lattice {
+    /// Rows along x or columns along y.
+    pub orientation: LatticeOrientation,
+    /// Overlap of neighbours, a fraction of the diameter.
+    pub overlap: f64,
+}
+
+/// Largest initial overlap of a hexagonal lattice (a fraction of the diameter): beyond it the
+/// contacts start far outside the small-overlap range of the linear contact law.
+pub const MAX_LATTICE_OVERLAP: f64 = 0.05;
+
 impl Default for PackingSpec {
     fn default() -> Self {
-        Self::Hexagonal { radius: 0.005, side: 0.1 }
+        Self::hexagonal(0.005, 0.1)
     }
 }
 
@@ -76,13 +120,30 @@ impl Default for PackingSpec {
 pub const MAX_DISCS: usize = 1_000_000;
 
 impl PackingSpec {
+    /// A hexagonal packing of discs of `radius` in a square of `side`, rows along x,
+    /// touching.
+    pub fn hexagonal(radius: f64, side: f64) -> Self {
+        Self::Hexagonal { radius, side, orientation: LatticeOrientation::Rows, overlap: 0.0 }
+    }
+
+    /// The lattice of a hexagonal packing (None for the others).
+    pub fn lattice(&self) -> Option<Lattice> {
+        match self {
+            PackingSpec::Hexagonal { orientation, overlap, .. } => {
+                Some(Lattice { orientation: *orientation, overlap: *overlap })
+            }
+            _ => None,
+        }
+    }
+
     /// The number of discs this packing will hold, estimated before anything is allocated
     /// (exact for an explicit radius list; within a few per cent otherwise). May be infinite
     /// for absurd ratios of side to radius.
     pub fn estimated_discs(&self) -> f64 {
         match self {
-            PackingSpec::Hexagonal { radius, side } => {
-                (side / (2.0 * radius) + 1.0) * (side / (3f64.sqrt() * radius) + 1.0)
+            PackingSpec::Hexagonal { radius, side, overlap, .. } => {
+                let h = radius * (1.0 - overlap);
+                (side / (2.0 * h) + 1.0) * (side / (3f64.sqrt() * h) + 1.0)
             }
             PackingSpec::Random { r_min, r_max, radii, side, .. } => {
                 if radii.is_empty() {
@@ -149,9 +210,16 @@ impl PackingSpec {
     /// Checks the packing's fields and that it holds at most [`MAX_DISCS`] discs.
     pub(super) fn validate(&self) -> Result<()> {
         match self {
-            PackingSpec::Hexagonal { radius, side } => {
+            PackingSpec::Hexagonal { radius, side, overlap, .. } => {
                 positive("packing.radius", *radius)?;
                 positive("packing.side", *side)?;
+                if !(0.0..=MAX_LATTICE_OVERLAP).contains(overlap) {
+                    return Err(invalid(
+                        "packing.overlap",
+                        overlap,
+                        "must be in [0, 0.05] (a fraction of the diameter)",
+                    ));
+                }
                 if *side < 8.0 * radius {
                     return Err(invalid(
                         "packing.side",

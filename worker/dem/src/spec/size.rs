@@ -3,6 +3,7 @@
 //! bytes of an exported assembly state.
 
 use super::{AssemblySpec, BoundarySpec, PackingSpec};
+use crate::packing::hexagonal;
 
 impl AssemblySpec {
     /// The number of discs [`crate::Assembly::new`] builds from this spec, computed from the
@@ -15,21 +16,17 @@ impl AssemblySpec {
     pub fn disc_count_hint(&self) -> u64 {
         let periodic = matches!(self.boundary, BoundarySpec::Periodic);
         let n = match &self.packing {
-            PackingSpec::Hexagonal { radius: r, side: l } => {
-                let (r, l) = (*r, *l);
-                let dy = 3f64.sqrt() * r;
-                if periodic {
-                    // `packing::hexagonal::periodic`.
-                    let n_col = (l / (2.0 * r)).round().max(4.0);
-                    let n_row = (2.0 * (l / (2.0 * dy)).round()).max(4.0);
-                    n_col * n_row
+            PackingSpec::Hexagonal { radius, side, .. } => {
+                let lattice = self.packing.lattice().unwrap_or_default();
+                if !(radius.is_finite() && side.is_finite() && lattice.overlap.is_finite()) {
+                    f64::NAN
+                } else if periodic {
+                    let (n_col, n_row) = hexagonal::periodic_grid(*radius, *side, lattice);
+                    n_col as f64 * n_row as f64
                 } else {
-                    // `packing::hexagonal::square`: even rows start at 0, odd rows at `r`.
-                    let n_row = ((l - 2.0 * r) / dy).floor() + 1.0;
-                    let cols = |off: f64| ((l - 2.0 * r - off) / (2.0 * r)).floor() + 1.0;
-                    let even = (n_row / 2.0).ceil();
-                    let odd = (n_row / 2.0).floor();
-                    even * cols(0.0) + odd * cols(r)
+                    // Even rows hold `even` discs, odd rows `odd`.
+                    let (n_row, even, odd) = hexagonal::square_rows(*radius, *side, lattice);
+                    n_row.div_ceil(2) as f64 * even as f64 + (n_row / 2) as f64 * odd as f64
                 }
             }
             PackingSpec::Random { r_min, r_max, radii, side, .. } => {
@@ -126,11 +123,24 @@ mod tests {
     /// a penalty square.
     #[test]
     fn the_hint_is_the_disc_count_built() {
-        for (r, l) in [(0.005, 0.1), (0.005, 0.043), (0.0031, 0.0517), (0.001, 0.02)] {
+        let sides = [(0.005, 0.1), (0.005, 0.043), (0.0031, 0.0517), (0.001, 0.02)];
+        for (r, l) in sides.into_iter().chain([(0.005, 0.0784f64.sqrt()), (0.005, 0.15)]) {
             for b in ["penalty", "periodic"] {
-                let s = hexagonal(r, l, b, 0.5);
-                let built = Assembly::new(&s).unwrap().disc_count() as u64;
-                assert_eq!(s.disc_count_hint(), built, "hexagonal r {r:?} side {l:?} {b}");
+                for (orientation, overlap) in [("rows", 0.0), ("columns", 0.02)] {
+                    let mut s = hexagonal(r, l, b, 0.5);
+                    if let PackingSpec::Hexagonal { orientation: o, overlap: d, .. } =
+                        &mut s.packing
+                    {
+                        *o = serde_json::from_value(serde_json::json!(orientation)).unwrap();
+                        *d = overlap;
+                    }
+                    let built = Assembly::new(&s).unwrap().disc_count() as u64;
+                    assert_eq!(
+                        s.disc_count_hint(),
+                        built,
+                        "hexagonal r {r:?} side {l:?} {b} {orientation} {overlap}"
+                    );
+                }
             }
         }
         let s = random("periodic", vec![], 0.5);
@@ -149,7 +159,7 @@ mod tests {
     fn an_absurd_spec_saturates() {
         assert_eq!(hexagonal(1e-300, 1e300, "periodic", 0.5).disc_count_hint(), u64::MAX);
         let nan = AssemblySpec {
-            packing: PackingSpec::Hexagonal { radius: f64::NAN, side: 0.1 },
+            packing: PackingSpec::hexagonal(f64::NAN, 0.1),
             ..AssemblySpec::default()
         };
         assert_eq!(nan.disc_count_hint(), u64::MAX);

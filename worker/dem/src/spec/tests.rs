@@ -10,7 +10,7 @@ fn every_variant() -> Vec<String> {
     }
     vec![
         json(&AssemblySpec::default()),
-        json(&PackingSpec::Hexagonal { radius: 0.005, side: 0.1 }),
+        json(&PackingSpec::hexagonal(0.005, 0.1)),
         json(&PackingSpec::Random {
             r_min: 0.004,
             r_max: 0.006,

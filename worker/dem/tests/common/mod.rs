@@ -6,11 +6,7 @@ use cosdem_dem::{AssemblySpec, BoundarySpec, PackingSpec};
 
 /// Hexagonal spec with radius 5 mm and the given side, paper contact law.
 pub fn hex_spec(side: f64, boundary: BoundarySpec) -> AssemblySpec {
-    AssemblySpec {
-        packing: PackingSpec::Hexagonal { radius: 0.005, side },
-        boundary,
-        ..Default::default()
-    }
+    AssemblySpec { packing: PackingSpec::hexagonal(0.005, side), boundary, ..Default::default() }
 }
 
 /// Paper penalty boundary.
