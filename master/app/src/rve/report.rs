@@ -214,19 +214,20 @@ impl RveWriter {
         s.final_friction_angle = phi;
         s.final_volumetric_strain = ev;
         self.history.push((r.step, phi, *m));
-        critical_state(&self.history, s);
         self.last = Some(r.clone());
         Ok(())
     }
 
-    /// The summary so far.
+    /// The summary so far (the critical state once [`Self::finish`] has run).
     pub fn summary(&self) -> &RveSummary {
         &self.summary
     }
 
-    /// Writes `rve.json` with the wall time.
+    /// Reads the critical state off the steps written and writes `rve.json` with the wall
+    /// time.
     pub fn finish(&mut self, wall_seconds: f64) -> crate::output::Result<()> {
         self.summary.wall_seconds = wall_seconds;
+        critical_state(&self.history, &mut self.summary);
         let path = self.dir.join("rve.json");
         // serde_json writes NaN (no peak, no dilation yet) as null.
         let json = serde_json::to_string_pretty(&self.summary)

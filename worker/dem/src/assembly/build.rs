@@ -8,7 +8,7 @@ use crate::integrate::{self, Dynamics, Work};
 use crate::packing::explicit::first_overlap;
 use crate::packing::{Packing, hexagonal, random};
 use crate::spec::{
-    AssemblySpec, BoundarySpec, PackingSpec, RelaxationSpec, RollingModel, TangentialModel,
+    AssemblySpec, BoundarySpec, Lattice, PackingSpec, RelaxationSpec, RollingModel, TangentialModel,
 };
 use cosdem_common::MacroDeformation;
 
@@ -16,8 +16,8 @@ pub(super) fn new(spec: &AssemblySpec) -> Result<Assembly> {
     spec.validate()?;
     let law = Law::from_params(&spec.contact);
     match &spec.packing {
-        PackingSpec::Hexagonal { radius, side, .. } => {
-            let lattice = spec.packing.lattice().unwrap_or_default();
+        PackingSpec::Hexagonal { radius, side, orientation, overlap } => {
+            let lattice = Lattice { orientation: *orientation, overlap: *overlap };
             let p = match spec.boundary {
                 BoundarySpec::Penalty { .. } => hexagonal::square(*radius, *side, lattice),
                 BoundarySpec::Periodic => hexagonal::periodic(*radius, *side, lattice),

@@ -126,16 +126,6 @@ impl PackingSpec {
         Self::Hexagonal { radius, side, orientation: LatticeOrientation::Rows, overlap: 0.0 }
     }
 
-    /// The lattice of a hexagonal packing (None for the others).
-    pub fn lattice(&self) -> Option<Lattice> {
-        match self {
-            PackingSpec::Hexagonal { orientation, overlap, .. } => {
-                Some(Lattice { orientation: *orientation, overlap: *overlap })
-            }
-            _ => None,
-        }
-    }
-
     /// The number of discs this packing will hold, estimated before anything is allocated
     /// (exact for an explicit radius list; within a few per cent otherwise). May be infinite
     /// for absurd ratios of side to radius.

@@ -2,7 +2,7 @@
 //! master sends and a worker checks its limits against before building) and a bound on the
 //! bytes of an exported assembly state.
 
-use super::{AssemblySpec, BoundarySpec, PackingSpec};
+use super::{AssemblySpec, BoundarySpec, Lattice, PackingSpec};
 use crate::packing::hexagonal;
 
 impl AssemblySpec {
@@ -16,8 +16,8 @@ impl AssemblySpec {
     pub fn disc_count_hint(&self) -> u64 {
         let periodic = matches!(self.boundary, BoundarySpec::Periodic);
         let n = match &self.packing {
-            PackingSpec::Hexagonal { radius, side, .. } => {
-                let lattice = self.packing.lattice().unwrap_or_default();
+            PackingSpec::Hexagonal { radius, side, orientation, overlap } => {
+                let lattice = Lattice { orientation: *orientation, overlap: *overlap };
                 if !(radius.is_finite() && side.is_finite() && lattice.overlap.is_finite()) {
                     f64::NAN
                 } else if periodic {
