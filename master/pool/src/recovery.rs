@@ -136,10 +136,12 @@ impl Pool {
         lost: Lost,
         redo: Redo<'_>,
     ) -> Result<Vec<GaussPointId>, MaterialError> {
-        let lost = lost.assemblies;
         // Back at their last committed step as the master knows it (during a commit, those
         // whose commit was acknowledged before their worker died are at its step already).
-        self.restore(&lost).await?;
+        // A worker lost during the restore takes its own assemblies down with it: they are
+        // restored too and lost their trials like the others, so what the call redoes is
+        // decided over all of them, not only over those the round lost.
+        let lost = self.restore(&lost.assemblies).await?;
         match redo {
             Redo::Nothing => Ok(Vec::new()),
             Redo::Export => Ok(lost),
@@ -170,8 +172,14 @@ impl Pool {
     /// Imports the stored committed states of `ids` on live workers (by cost) and replays the
     /// increments committed since ([`replay`](crate::replay)), so that each assembly is back
     /// at its last committed step with no trial; retries on other workers when a target fails.
-    pub(crate) async fn restore(&mut self, ids: &[GaussPointId]) -> Result<(), MaterialError> {
+    /// Returns every assembly restored, sorted: `ids` and those that workers lost on the way
+    /// held besides (their trials are gone too).
+    pub(crate) async fn restore(
+        &mut self,
+        ids: &[GaussPointId],
+    ) -> Result<Vec<GaussPointId>, MaterialError> {
         let mut todo: Vec<GaussPointId> = ids.to_vec();
+        let mut restored: Vec<GaussPointId> = ids.to_vec();
         let mut rounds = Rounds::default();
         while !todo.is_empty() {
             if let Some(done) = rounds.start(self.workers.len()) {
@@ -243,11 +251,14 @@ impl Pool {
                 .await?;
             // Those it held before, and those it was to take.
             todo = lost.workers.iter().flat_map(|w| by_worker[w].iter().copied()).collect();
+            restored.extend(lost.assemblies.iter().copied());
             todo.extend(lost.assemblies);
             todo.sort();
             todo.dedup();
         }
-        Ok(())
+        restored.sort();
+        restored.dedup();
+        Ok(restored)
     }
 }
 
