@@ -62,7 +62,9 @@ impl CurveAxes {
             return None;
         }
         let sum: f64 = nodes.iter().map(|&n| view.dofs[n * ndf + k]).sum();
-        Some(self.control.scale * sum / nodes.len() as f64)
+        // `+ 0.0` turns a held set's -0 (0 times a negative scale) into 0 and changes no
+        // other value.
+        Some(self.control.scale * sum / nodes.len() as f64 + 0.0)
     }
 
     /// The load: the load set's reaction component times the load scale (0 for a set the
@@ -179,5 +181,10 @@ mod tests {
         let mut unknown = a.clone();
         unknown.control.set = "nosuch".into();
         assert_eq!(unknown.control_displacement(&view), None);
+        // A held set (a footing before it is pushed) under scale -1 reads 0, not "-0".
+        let held = vec![0.0; 3 * mesh.n_nodes()];
+        let view = SolutionView { dofs: &held, ..view };
+        let zero = a.control_displacement(&view).unwrap();
+        assert!(zero == 0.0 && zero.is_sign_positive(), "{zero}");
     }
 }
