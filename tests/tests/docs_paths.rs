@@ -1,5 +1,5 @@
-//! The docs name only paths that exist. In `README.md`, `docs/theory.md`, `docs/guide/*.md`
-//! and `docs/reference/*.md`:
+//! The docs name only paths that exist. In `README.md`, `docs/theory.md`, `docs/guide/*.md`,
+//! `docs/reference/*.md` and `docs/problems/*.md`:
 //!
 //! - every repository path in backticks (an inline span such as `master/fem/src/solve/newton.rs`,
 //!   or a word of a fenced block such as the `examples/quick.toml` of a command) exists;
@@ -23,7 +23,7 @@ fn root() -> PathBuf {
 /// The documents checked, in a fixed order.
 fn documents(root: &Path) -> Vec<PathBuf> {
     let mut docs = vec![root.join("README.md"), root.join("docs/theory.md")];
-    for dir in ["docs/guide", "docs/reference"] {
+    for dir in ["docs/guide", "docs/reference", "docs/problems"] {
         let mut md: Vec<PathBuf> = std::fs::read_dir(root.join(dir))
             .unwrap_or_else(|e| panic!("{dir}: {e}"))
             .map(|e| e.unwrap().path())

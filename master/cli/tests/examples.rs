@@ -58,6 +58,17 @@ const EXAMPLES: &[(&str, u64)] = &[
     ("slope", 2),
     // 0.7 s for steps 1-2 (32 points x 147 discs, the first two loading steps).
     ("cyclic-biaxial", 2),
+    // The geotechnical checks of issue 31 (docs/problems/), FEMxDEM's geometries. Step 1 is
+    // the surcharge (2 Newton iterations), step 2 the first move of the wall or the footing
+    // (the iteration limit, 21 solves of every point).
+    // 53 s for steps 1-2 (800 points x 147 discs; measured 2026-12-07 beside a release run,
+    // so about half that on a quiet machine).
+    ("retaining-smooth-active", 2),
+    // 3.8 s for step 1 (800 points x 147 discs): the passive job differs only in the sign of
+    // the wall's move, which step 2 of the active one covers.
+    ("retaining-smooth-passive", 1),
+    // 62 s for steps 1-2 (1 287 points x 147 discs), measured as the wall's.
+    ("footing-femxdem", 2),
 ];
 
 /// The workspace root (this crate is `master/cli`).
@@ -66,8 +77,8 @@ fn root() -> PathBuf {
 }
 
 /// The first `steps` steps of `examples/<stem>.toml` against `examples/expected/<stem>.csv`,
-/// or, with `COSDEM_BLESS` set, the run's curve written there.
-fn check_prefix(stem: &str) {
+/// or, with `COSDEM_BLESS` set, the run's curve written there. Returns the run directory.
+fn check_prefix(stem: &str) -> PathBuf {
     let steps = EXAMPLES
         .iter()
         .find(|(s, _)| *s == stem)
@@ -97,7 +108,7 @@ fn check_prefix(stem: &str) {
     let expected = root.join("examples/expected").join(format!("{stem}.csv"));
     if std::env::var_os("COSDEM_BLESS").is_some() {
         std::fs::write(&expected, &curve).expect("writing the expected prefix");
-        return;
+        return out;
     }
     let want = std::fs::read(&expected).unwrap_or_else(|e| {
         panic!(
@@ -112,6 +123,18 @@ fn check_prefix(stem: &str) {
         String::from_utf8_lossy(&want),
         String::from_utf8_lossy(&curve)
     );
+    out
+}
+
+/// What a geotechnical check (docs/problems/) reads besides the curve, written from the first
+/// step on: the equivalent-strain field data of step 1 (the failure mechanism is read from
+/// these fields) and the nodal and Gauss-point VTK series.
+fn check_fields(out: &Path) {
+    for file in ["fields/field_00001.json", "fields.pvd", "gauss.pvd"] {
+        assert!(out.join(file).is_file(), "{} was not written", out.join(file).display());
+    }
+    let field = std::fs::read_to_string(out.join("fields/field_00001.json")).expect("readable");
+    assert!(field.contains("equivalent_strain"), "field data without the equivalent strain");
 }
 
 /// Every `examples/*.toml` has an entry in [`EXAMPLES`], a committed prefix and a claims file
@@ -202,4 +225,19 @@ fn slope() {
 #[test]
 fn cyclic_biaxial() {
     check_prefix("cyclic-biaxial");
+}
+
+#[test]
+fn retaining_smooth_active() {
+    check_fields(&check_prefix("retaining-smooth-active"));
+}
+
+#[test]
+fn retaining_smooth_passive() {
+    check_fields(&check_prefix("retaining-smooth-passive"));
+}
+
+#[test]
+fn footing_femxdem() {
+    check_fields(&check_prefix("footing-femxdem"));
 }
