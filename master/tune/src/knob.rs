@@ -207,6 +207,11 @@ impl Knob {
     pub fn value(self, job: &Job) -> String {
         match self {
             Knob::LoadStep => {
+                if job.is_staged() {
+                    let steps: Vec<String> =
+                        job.stage.iter().map(|s| s.steps.to_string()).collect();
+                    return format!("stage steps [{}]", steps.join(", "));
+                }
                 return match job.loading.increment {
                     Some(inc) => format!("increment {inc} m"),
                     None => format!("{} steps", job.loading.steps),
@@ -427,9 +432,14 @@ impl std::str::FromStr for Knob {
     }
 }
 
-/// Multiplies the job's load step by `f` (a job given by its step count takes `1/f` as many).
+/// Multiplies the job's load step by `f` (a job given by its step count takes `1/f` as many,
+/// at least one; a job in stages, each stage: its loads are totals, so its steps change).
 fn scale_load_step(job: &mut Job, f: f64) {
-    if let Some(inc) = &mut job.loading.increment {
+    if job.is_staged() {
+        for s in &mut job.stage {
+            s.steps = ((s.steps as f64 / f).round() as usize).max(1);
+        }
+    } else if let Some(inc) = &mut job.loading.increment {
         *inc *= f;
     } else {
         job.loading.steps = ((job.loading.steps as f64 / f).round() as usize).max(1);
@@ -482,11 +492,7 @@ pub fn reference(base: &Job) -> Variant {
         j.newton.secant_updates = false;
         // Every attempt iterates to its cap: no early end on a stalled residual.
         j.newton.stall_iterations = 0;
-        if let Some(inc) = &mut j.loading.increment {
-            *inc *= 0.5;
-        } else {
-            j.loading.steps *= 2;
-        }
+        scale_load_step(j, 0.5);
         if let Some(a) = assembly_mut(j) {
             a.relaxation.tolerance = 1e-5;
             a.relaxation.safety = 0.25;

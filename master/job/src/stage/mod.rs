@@ -187,7 +187,7 @@ impl Job {
         Ok(())
     }
 
-    /// What a job in stages may not have: `[loading]` loads, an accuracy target.
+    /// What a job in stages may not have: `[loading]` loads.
     fn validate_staged_job(&self) -> Result<()> {
         let l = &self.loading;
         if l.compression.is_some()
@@ -199,15 +199,6 @@ impl Job {
                 "loading",
                 "[loading] with loads",
                 "a job in [[stage]] puts its loads in its stages; [loading] keeps only load_set",
-            ));
-        }
-        if let Some(a) = self.accuracy {
-            // The planner's load-step knob scales `[loading]`'s steps: it does not know
-            // stages yet.
-            return Err(bad(
-                "accuracy",
-                format!("{a:?}"),
-                "an accuracy target plans a one-stage job; a job in [[stage]] gives each stage's steps",
             ));
         }
         Ok(())

@@ -497,3 +497,25 @@ fn committed_tables_parse_and_plan() {
     plain.accuracy = None;
     assert_eq!(fallback.job, crate::knob::reference(&plain).job);
 }
+
+/// A job in stages plans like a one-stage job (the load-step knob scales each stage's steps:
+/// `crate::knob`'s tests). The retaining wall's random assemblies plan from the committed
+/// biaxial table as the guide says: 5 % moves nothing (the table's default is already more
+/// than half of it from the reference) and leaves the job as written; 20 % picks the relaxation
+/// tolerance 1e-3 and the warm start, and keeps the stages' loads and steps.
+#[test]
+fn a_job_in_stages_plans() {
+    let text = include_str!("../../../../examples/retaining-smooth-active.toml");
+    let wall = |a: f64| Job::from_toml(&format!("accuracy = {a}\n{text}"), "wall").unwrap();
+    let five = tune(&wall(0.05)).unwrap().unwrap();
+    assert!(five.report.knobs.iter().all(|c| c.row.is_none()), "{:?}", five.report.knobs);
+    assert_eq!(five.job.stage, wall(0.05).stage);
+    let twenty = tune(&wall(0.2)).unwrap().unwrap();
+    let moved = moved(&twenty);
+    assert!(moved.contains(&"relaxation.tolerance=1e-3".to_string()), "{moved:?}");
+    assert!(moved.contains(&"warm_start=true".to_string()), "{moved:?}");
+    assert_eq!(twenty.job.stage, wall(0.2).stage);
+    assert_eq!(assembly(&twenty.job).relaxation.tolerance, 1e-3);
+    let step = knob_choice(&twenty, "load_step");
+    assert!(step.was.starts_with("stage steps [1, 30]"), "{}", step.was);
+}

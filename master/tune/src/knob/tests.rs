@@ -198,3 +198,28 @@ fn an_analytical_material_has_no_assembly_knobs() {
         );
     }
 }
+
+/// A job in stages: the load-step knob scales each stage's step count (the stage's loads are
+/// totals), at least one step, rounded; the reference doubles each stage's steps, and the
+/// report names them. The retaining wall's first stage (the surcharge in 1 step) keeps 1
+/// under `x2`, its push of 30 steps takes 15; the reference runs 2 and 60.
+#[test]
+fn the_load_step_of_a_job_in_stages_is_each_stages_steps() {
+    let path = "examples/retaining-smooth-active.toml";
+    let text = include_str!("../../../../examples/retaining-smooth-active.toml");
+    let job = Job::from_toml(text, path).unwrap();
+    let steps = |j: &Job| j.stage.iter().map(|s| s.steps).collect::<Vec<_>>();
+    let given = steps(&job);
+    assert_eq!(given.len(), 2, "{given:?}");
+    let mut coarse = job.clone();
+    Knob::LoadStep.apply(&mut coarse, "x2").unwrap();
+    let expect = |f: f64| {
+        given.iter().map(|&n| ((n as f64 / f).round() as usize).max(1)).collect::<Vec<_>>()
+    };
+    assert_eq!(steps(&coarse), expect(2.0));
+    assert_eq!(steps(&coarse), [1, 15]);
+    assert_eq!(coarse.loading, job.loading);
+    let fine = reference(&job).job;
+    assert_eq!(steps(&fine), given.iter().map(|n| 2 * n).collect::<Vec<_>>());
+    assert_eq!(Knob::LoadStep.value(&job), format!("stage steps [{}, {}]", given[0], given[1]));
+}
