@@ -69,6 +69,9 @@ const EXAMPLES: &[(&str, u64)] = &[
     ("retaining-smooth-passive", 1),
     // 62 s for steps 1-2 (1 287 points x 147 discs), measured as the wall's.
     ("footing-femxdem", 2),
+    // Step 1 of the 512-point biaxial test with its weak element (400 discs each; the cheap
+    // relaxation the job sets).
+    ("biaxial-shear-band", 1),
 ];
 
 /// The workspace root (this crate is `master/cli`).
@@ -240,4 +243,15 @@ fn retaining_smooth_passive() {
 #[test]
 fn footing_femxdem() {
     check_fields(&check_prefix("footing-femxdem"));
+}
+
+/// The weak element is a second material: its points get their own specimen.
+#[test]
+fn biaxial_shear_band() {
+    let out = check_prefix("biaxial-shear-band");
+    check_fields(&out);
+    let summary = std::fs::read_to_string(out.join("summary.json")).expect("summary.json");
+    let specimens = summary.split("\"specimens\"").nth(1).expect("summary.json's specimens");
+    assert!(specimens.contains("\"distinct\": 2,"), "{summary}");
+    assert!(specimens.contains("\"points\": 512"), "{summary}");
 }
