@@ -32,8 +32,9 @@
 //! bit in a header cannot pass for another format (3, 5 and 6 are one bit from one of them). The assembly states
 //! inside (`cosdem_dem::Assembly::to_bytes`) carry a checksum of their own, made the same way.
 //!
-//! The checkpoint also stores a digest of the job's physics (mesh, loading, material) and one
-//! of its Newton settings: resuming with a job whose physics changed is refused, and so is one
+//! The checkpoint also stores a digest of the job's physics (mesh, loading, material; a Gmsh
+//! mesh by its content, so that a job moved with its mesh resumes) and one of its Newton
+//! settings: resuming with a job whose physics changed is refused, and so is one
 //! whose Newton settings changed unless the resume says so (`--newton-changed`): the steps
 //! already done stay as they were and only the steps to come are solved with the new settings
 //! (a run that stalls past a peak can go on with more iterations or another tolerance instead
@@ -271,7 +272,8 @@ impl Checkpoint {
     /// steps to come are solved with the job's; a warning is logged).
     pub fn check_job(&self, job: &Job, path: &Path, newton_changed: bool) -> Result<()> {
         let Digests { job: d, newton: n } = Digests::of(job);
-        if d != self.digests.job {
+        // A checkpoint written before the mesh entered by its content holds the path digest.
+        if d != self.digests.job && path_job_digest(job) != self.digests.job {
             return Err(bad(
                 path,
                 format!(
@@ -325,11 +327,36 @@ impl Digests {
 /// that has them, its `[[stage]]`s, `[[region]]`s and `[specimens]`, as JSON (a job without stages keeps the digest it had
 /// before stages existed). Output and worker settings may change between a run and its
 /// resume.
+///
+/// A Gmsh mesh enters by its content, not its path: `mesh.file` is replaced by the FNV-1a
+/// digest of the file's bytes, so a job moved or copied with its mesh resumes, and a mesh
+/// edited in place is refused. A mesh file that cannot be read enters by its path (reading it
+/// for the run then fails, naming it). A job with a generated mesh has the digest it had
+/// before.
 pub fn job_digest(job: &Job) -> u64 {
+    let content = job.mesh.file.as_deref().and_then(|f| std::fs::read(f).ok());
+    match content {
+        Some(bytes) => {
+            let mut mesh = job.mesh.clone();
+            mesh.file = Some(PathBuf::from(format!("fnv1a:{:016x}", fnv1a_bytes(&bytes))));
+            physics_digest(job, &mesh)
+        }
+        None => path_job_digest(job),
+    }
+}
+
+/// The digest of earlier cosdems, [`job_digest`] with a Gmsh mesh entering by its path: their
+/// checkpoints still resume where the job and its mesh stayed.
+fn path_job_digest(job: &Job) -> u64 {
+    physics_digest(job, &job.mesh)
+}
+
+/// [`job_digest`] with `mesh` for the job's `[mesh]`.
+fn physics_digest(job: &Job, mesh: &cosdem_job::MeshSection) -> u64 {
     let json = if job.stage.is_empty() {
-        serde_json::to_string(&(&job.mesh, &job.loading, &job.material))
+        serde_json::to_string(&(mesh, &job.loading, &job.material))
     } else {
-        serde_json::to_string(&(&job.mesh, &job.loading, &job.material, &job.stage))
+        serde_json::to_string(&(mesh, &job.loading, &job.material, &job.stage))
     };
     let mut json = json.unwrap_or_default();
     // Regions and specimens, in a job that has them.
@@ -346,8 +373,13 @@ pub fn newton_digest(job: &Job) -> u64 {
 
 /// FNV-1a, 64 bits: the digests of a job (here and in the run directory's provenance).
 pub(crate) fn fnv1a(text: &str) -> u64 {
+    fnv1a_bytes(text.as_bytes())
+}
+
+/// [`fnv1a`] of bytes.
+fn fnv1a_bytes(bytes: &[u8]) -> u64 {
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for b in text.bytes() {
+    for &b in bytes {
         h ^= u64::from(b);
         h = h.wrapping_mul(0x0000_0100_0000_01b3);
     }

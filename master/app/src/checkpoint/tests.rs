@@ -362,3 +362,41 @@ fn a_stepper_checkpoint_keeps_its_stages_and_a_runs_keeps_its_bytes() {
     assert!(e.contains(FILE) && e.contains("written by a stepper"), "{e}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A Gmsh mesh enters the physics digest by its content, not its path: the footing example
+/// copied with its mesh into two directories has one digest, so a checkpoint written in one
+/// resumes the other; the mesh changed by one byte in the second is refused as another job.
+/// A checkpoint holding the path digest of earlier cosdems still resumes where its job and
+/// mesh stayed, and only there.
+#[test]
+fn a_job_moved_with_its_mesh_resumes_and_an_edited_mesh_is_refused() {
+    let examples = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../examples");
+    let base = scratch("moved-mesh");
+    let (a, b) = (base.join("a"), base.join("b"));
+    for dir in [&a, &b] {
+        std::fs::create_dir_all(dir).unwrap();
+        for f in ["footing.toml", "footing.msh"] {
+            std::fs::copy(examples.join(f), dir.join(f)).unwrap();
+        }
+    }
+    let job_a = Job::load(&a.join("footing.toml")).unwrap();
+    let job_b = Job::load(&b.join("footing.toml")).unwrap();
+    assert_ne!(job_a.mesh.file, job_b.mesh.file, "the two jobs name different files");
+    assert_eq!(job_digest(&job_a), job_digest(&job_b));
+    let mut c = awkward();
+    c.digests = Digests::of(&job_a);
+    c.check_job(&job_b, &b, false).unwrap();
+    // Earlier cosdems' digest: accepted in place, refused for the moved job.
+    c.digests.job = path_job_digest(&job_a);
+    c.check_job(&job_a, &a, false).unwrap();
+    assert!(c.check_job(&job_b, &b, false).unwrap_err().to_string().contains("another job"));
+    // One byte more in the moved mesh (a trailing newline) is another mesh.
+    let mesh_b = b.join("footing.msh");
+    let mut bytes = std::fs::read(&mesh_b).unwrap();
+    bytes.push(b'\n');
+    std::fs::write(&mesh_b, bytes).unwrap();
+    c.digests = Digests::of(&job_a);
+    let e = c.check_job(&job_b, &b, false).unwrap_err().to_string();
+    assert!(e.contains("another job"), "{e}");
+    std::fs::remove_dir_all(&base).unwrap();
+}
