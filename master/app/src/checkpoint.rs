@@ -9,12 +9,12 @@
 //! solve is deterministic given (committed state, target), and everything else is restored
 //! exactly (postcard writes each `f64` as its 8 little-endian bytes).
 //!
-//! Format `CDEMCKP7`: the 8-byte header `CDEMCKP7`, one postcard [`Checkpoint`] (serde with a
+//! Format `CDEMCKP8`: the 8-byte header `CDEMCKP8`, one postcard [`Checkpoint`] (serde with a
 //! specified wire format), and a CRC-32 (IEEE, little-endian) of every byte before it. A
 //! damaged file (a flipped bit anywhere) is refused by its checksum, naming the file; so is a
 //! checkpoint of the older formats of an earlier cosdem (`CDEMCKP1`, `CDEMCKP2`: bincode;
-//! `CDEMCKP4`: postcard without the solver's stage and the answers' micro descriptors), by
-//! name: that run must be restarted.
+//! `CDEMCKP4`: postcard without the solver's stage and the answers' micro descriptors;
+//! `CDEMCKP7`: without the path control's progress), by name: that run must be restarted.
 //!
 //! A checkpoint of a [`crate::stepper::Stepper`] also holds the caller's stages so far
 //! (`Checkpoint::stages`), so that a resume goes on with the same loading: they follow the
@@ -28,8 +28,8 @@
 //! every single-bit error and every burst of up to 32 bits (a damaged disk block, a bad copy),
 //! it is the standard polynomial any zlib recomputes, and it runs at memory speed; a damaged
 //! file that matches by chance (2^-32) is no concern for a check against damage. The version
-//! is 7: `'7'` is two bits from each of the older `'1'`, `'2'` and `'4'`, so a single flipped
-//! bit in a header cannot pass for another format (3, 5 and 6 are one bit from one of them). The assembly states
+//! is 8: `'8'` is two bits from each of the older `'1'`, `'2'` and `'4'` and four from `'7'`,
+//! so a single flipped bit in a header cannot pass for another format. The assembly states
 //! inside (`cosdem_dem::Assembly::to_bytes`) carry a checksum of their own, made the same way.
 //!
 //! The checkpoint also stores a digest of the job's physics (mesh, loading, material; a Gmsh
@@ -53,12 +53,13 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// The header of the format written (postcard and a CRC-32).
-const MAGIC: &[u8; 8] = b"CDEMCKP7";
+const MAGIC: &[u8; 8] = b"CDEMCKP8";
 
 /// The headers of the formats of earlier cosdems: `CDEMCKP1` (bincode, before the Newton
-/// settings had a digest of their own), `CDEMCKP2` (bincode) and `CDEMCKP4` (postcard, before
-/// stages and micro descriptors). Refused by name.
-const OLD_MAGICS: [&[u8; 8]; 3] = [b"CDEMCKP1", b"CDEMCKP2", b"CDEMCKP4"];
+/// settings had a digest of their own), `CDEMCKP2` (bincode), `CDEMCKP4` (postcard, before
+/// stages and micro descriptors) and `CDEMCKP7` (before the path control's progress).
+/// Refused by name.
+const OLD_MAGICS: [&[u8; 8]; 4] = [b"CDEMCKP1", b"CDEMCKP2", b"CDEMCKP4", b"CDEMCKP7"];
 
 /// Bytes of the trailing CRC-32.
 const CRC_LEN: usize = 4;
@@ -206,7 +207,7 @@ impl Checkpoint {
         if head != MAGIC {
             return Err(bad(
                 path,
-                "not a cosdem checkpoint (no CDEMCKP7 header), or its header is damaged".into(),
+                "not a cosdem checkpoint (no CDEMCKP8 header), or its header is damaged".into(),
             ));
         }
         if bytes.len() < MAGIC.len() + CRC_LEN {

@@ -3,8 +3,8 @@
 //! about the job file.
 
 use crate::schema::{
-    ComponentChoice, Continuum, ElementChoice, Integration, Job, MaterialSection, MeshKind, Moving,
-    PlatenChoice, RampChoice,
+    ComponentChoice, Continuum, ControlSection, ElementChoice, Integration, Job, MaterialSection,
+    MeshKind, Moving, PlatenChoice, RampChoice,
 };
 use cosdem_fem::assembly::{Component, Field};
 use cosdem_fem::element::{ElementKind, QuadratureRule};
@@ -128,6 +128,7 @@ impl Job {
                 ramp,
             });
         }
+        loading.control = l.control.as_ref().map(ControlSection::path_control);
         self.mesh.symmetry.reduce_loading(loading, self.field())
     }
 
@@ -171,6 +172,9 @@ impl Job {
             curve.check_sets(&mesh)?;
         }
         self.check_stage_sets(&mesh)?;
+        if let Some(c) = &self.loading.control {
+            check_control("loading.control", c, &mesh)?;
+        }
         // A bad region is refused here, before anything runs.
         let element_materials = self.element_materials(&mesh)?;
         let loading = match self.is_staged() {
@@ -286,4 +290,28 @@ mod tests {
         assert_eq!(top.unwrap().value, -0.005);
         assert_eq!(bottom.unwrap().value, 0.005);
     }
+}
+
+/// A path control's node set must be a non-empty set of the mesh and its value finite and
+/// not zero (`at`: the control's key, `loading.control` or `stage[i].control`).
+pub(crate) fn check_control(at: &str, c: &ControlSection, mesh: &Mesh) -> Result<()> {
+    let field = |rest: &str| crate::validate::interned(format!("{at}.{rest}"));
+    if mesh.node_sets.get(&c.set).is_none_or(Vec::is_empty) {
+        return Err(Error::InvalidSetting {
+            field: field("set"),
+            value: c.set.clone(),
+            reason: format!(
+                "the mesh has no non-empty node set of that name (known: {})",
+                mesh.node_sets.keys().cloned().collect::<Vec<_>>().join(", ")
+            ),
+        });
+    }
+    if !(c.value.is_finite() && c.value != 0.0) {
+        return Err(Error::InvalidSetting {
+            field: field("value"),
+            value: c.value.to_string(),
+            reason: "must be finite and not zero (the control quantity's change)".into(),
+        });
+    }
+    Ok(())
 }

@@ -211,6 +211,33 @@ pub struct Prescribed {
     pub value: f64,
 }
 
+/// `[loading.control]` (or `[stage.control]`): path control. The steps advance the mean of
+/// `component` over the node set `set` by `value` in all, from where it is, instead of the
+/// load factor; the load factor of the prescribed dofs and loads is solved for at each step,
+/// so the load-displacement path may turn back (a snap-back) without the run failing. The
+/// run (stage) ends when the control quantity has moved by `value`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ControlSection {
+    /// Node set (a Gmsh physical name or a structured mesh's side or corner).
+    pub set: String,
+    /// `ux`, `uy` or `w`.
+    pub component: ComponentChoice,
+    /// The change of the set's mean `component` over the run or stage (m or rad; not 0).
+    pub value: f64,
+}
+
+impl ControlSection {
+    /// The solver's path control.
+    pub fn path_control(&self) -> cosdem_fem::solve::PathControl {
+        cosdem_fem::solve::PathControl {
+            set: self.set.clone(),
+            component: self.component.into(),
+            value: self.value,
+        }
+    }
+}
+
 /// How an edge load follows the loading.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -258,6 +285,8 @@ pub struct LoadingSection {
     /// Node set whose reaction is "the load" of the curve (default `top`).
     #[serde(default = "default_load_set")]
     pub load_set: String,
+    /// Path control: the steps advance a set's mean displacement, the load factor follows.
+    pub control: Option<ControlSection>,
 }
 
 fn default_steps() -> usize {
@@ -276,6 +305,7 @@ impl Default for LoadingSection {
             prescribed: Vec::new(),
             pressure: Vec::new(),
             load_set: default_load_set(),
+            control: None,
         }
     }
 }

@@ -266,3 +266,44 @@ gravity = { acceleration = [0.0, -9.81], ramp = "remove" }
 struct StageList {
     stage: Vec<cosdem_job::StageSection>,
 }
+
+/// `[loading.control]` and `[stage.control]` reach the solver's loading (the stage's on its
+/// own stage only: a path control is not held into the next stage), and a control on a set
+/// the mesh lacks is refused naming the key and the value.
+#[test]
+fn path_controls_reach_the_loading_and_unknown_sets_are_refused() {
+    let got = stages(
+        "[[stage]]\nprescribed = [{ set = \"top\", component = \"uy\", value = -1e-3 }]\n\
+         control = { set = \"left\", component = \"ux\", value = -2e-4 }\n[[stage]]\n",
+    );
+    let c = got[0].loading.control.as_ref().expect("the first stage's control");
+    assert_eq!((c.set.as_str(), c.component, c.value), ("left", Component::Ux, -2e-4));
+    assert!(got[1].loading.control.is_none());
+    let e = staged("[[stage]]\ncontrol = { set = \"lid\", component = \"uy\", value = 1e-3 }\n")
+        .unwrap()
+        .model()
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("stage[0].control.set") && e.contains("lid"), "{e}");
+
+    let plain = |control: &str| {
+        let text = format!(
+            "[mesh]\nkind = \"rectangle\"\nlx = 1.0\nly = 1.0\nnx = 2\nny = 2\n\n\
+             [material]\nkind = \"elastic\"\nshear_modulus = 1e7\npoisson = 0.3\n\n\
+             [loading.compression]\ndisplacement = 0.01\n\n[loading.control]\n{control}"
+        );
+        Job::from_toml(&text, "control.toml").map_err(|e| e.to_string())
+    };
+    let model =
+        plain("set = \"left\"\ncomponent = \"ux\"\nvalue = -1e-3\n").unwrap().model().unwrap();
+    let c = model.loading.control.expect("the job's control");
+    assert_eq!((c.set.as_str(), c.component, c.value), ("left", Component::Ux, -1e-3));
+    let e =
+        plain("set = \"side\"\ncomponent = \"ux\"\nvalue = -1e-3\n").unwrap().model().unwrap_err();
+    assert!(e.to_string().contains("loading.control.set") && e.to_string().contains("side"), "{e}");
+    let e =
+        plain("set = \"left\"\ncomponent = \"ux\"\nvalue = 0.0\n").unwrap().model().unwrap_err();
+    assert!(e.to_string().contains("loading.control.value"), "{e}");
+    let e = plain("set = \"left\"\ncomponent = \"ux\"\n").unwrap_err();
+    assert!(e.contains("value"), "{e}");
+}

@@ -202,6 +202,7 @@ fn awkward() -> Checkpoint {
             reactions: BTreeMap::from([("top".to_string(), [1.5, -0.0, 7e-310])]),
             stage: 2,
             stage_start: Some(vec![-0.0, 1e-3, f64::MIN_POSITIVE]),
+            progress: 0.1 + 0.7,
         },
         assemblies: vec![SavedAssembly {
             id: GaussPointId::new(0, 3),
@@ -230,7 +231,7 @@ fn round_trip_is_bit_exact() {
     let c = awkward();
     c.write(&path).unwrap();
     let bytes = std::fs::read(&path).unwrap();
-    assert_eq!(&bytes[..8], b"CDEMCKP7");
+    assert_eq!(&bytes[..8], b"CDEMCKP8");
     let back = Checkpoint::read(&path).unwrap();
     let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
     assert_eq!(bits(&back.solver.u), bits(&c.solver.u));
@@ -261,7 +262,7 @@ fn every_flipped_bit_is_refused_naming_the_file() {
         let e = Checkpoint::read(&path).unwrap_err().to_string();
         assert!(e.contains(&path.display().to_string()), "bit {bit}: {e}");
         if bit < 64 {
-            assert!(e.contains("no CDEMCKP7 header") && e.contains("damaged"), "bit {bit}: {e}");
+            assert!(e.contains("no CDEMCKP8 header") && e.contains("damaged"), "bit {bit}: {e}");
         } else {
             assert!(e.contains("damaged: the CRC-32"), "bit {bit}: {e}");
         }
@@ -275,7 +276,7 @@ fn every_flipped_bit_is_refused_naming_the_file() {
 fn old_and_foreign_files_are_refused_by_name() {
     let dir = scratch("format");
     let path = dir.join(FILE);
-    for old in ["CDEMCKP1", "CDEMCKP2", "CDEMCKP4"] {
+    for old in ["CDEMCKP1", "CDEMCKP2", "CDEMCKP4", "CDEMCKP7"] {
         std::fs::write(&path, format!("{old} and whatever bincode followed")).unwrap();
         let e = Checkpoint::read(&path).unwrap_err().to_string();
         assert!(
@@ -289,7 +290,7 @@ fn old_and_foreign_files_are_refused_by_name() {
     std::fs::write(&path, b"PK\x03\x04 a zip file").unwrap();
     let foreign = Checkpoint::read(&path).unwrap_err().to_string();
     assert!(foreign.contains("not a cosdem checkpoint"), "{foreign}");
-    std::fs::write(&path, b"CDEMCKP7").unwrap();
+    std::fs::write(&path, b"CDEMCKP8").unwrap();
     let short = Checkpoint::read(&path).unwrap_err().to_string();
     assert!(short.contains("truncated"), "{short}");
     std::fs::remove_dir_all(&dir).unwrap();

@@ -571,7 +571,9 @@ impl StepObserver for RunWriter {
             step: report.step,
             displacement,
             time,
-            last: report.load_factor >= 1.0 - 1e-12,
+            // The stage's end: its load factor at 1, or a path control's progress (the
+            // pseudo-time's fraction of the stage).
+            last: report.time - f64::from(report.stage) >= 1.0 - 1e-12,
             on_cadence,
             internal_length: self.settings.internal_length,
         };

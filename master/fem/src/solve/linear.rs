@@ -48,11 +48,24 @@ impl LinearSolver {
         rhs: &mut [f64],
         symmetric: bool,
     ) -> std::result::Result<(), String> {
-        if rhs.is_empty() {
+        let n = rhs.len();
+        self.solve_columns(values, rhs, n, symmetric)
+    }
+
+    /// Solves `K X = RHS` in place for the columns of `rhs` (column-major, `n` rows each):
+    /// one factorization for all of them.
+    pub fn solve_columns(
+        &mut self,
+        values: &[f64],
+        rhs: &mut [f64],
+        n: usize,
+        symmetric: bool,
+    ) -> std::result::Result<(), String> {
+        if rhs.is_empty() || n == 0 {
             return Ok(());
         }
         let k = SparseColMatRef::new(self.symbolic.as_ref(), values);
-        let n = rhs.len();
+        let m = rhs.len() / n;
         if symmetric {
             if self.llt.is_none() {
                 let s = SymbolicLlt::try_new(self.symbolic.as_ref(), Side::Lower)
@@ -61,7 +74,7 @@ impl LinearSolver {
             }
             let s = self.llt.clone().expect("set above");
             if let Ok(f) = Llt::try_new_with_symbolic(s, k, Side::Lower) {
-                f.solve_in_place(MatMut::from_column_major_slice_mut(rhs, n, 1));
+                f.solve_in_place(MatMut::from_column_major_slice_mut(rhs, n, m));
                 return finite(rhs);
             }
             tracing::warn!("Cholesky failed (tangent not positive definite); using LU");
@@ -73,7 +86,7 @@ impl LinearSolver {
         }
         let s = self.lu.clone().expect("set above");
         let f = Lu::try_new_with_symbolic(s, k).map_err(|e| format!("LU: {e:?}"))?;
-        f.solve_in_place(MatMut::from_column_major_slice_mut(rhs, n, 1));
+        f.solve_in_place(MatMut::from_column_major_slice_mut(rhs, n, m));
         finite(rhs)
     }
 

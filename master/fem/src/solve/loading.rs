@@ -36,6 +36,20 @@ impl Dirichlet {
     }
 }
 
+/// Path control of a stage ([`super::control`]): its steps advance the mean of `component`
+/// over the node set `set` by `value` in all (from its value at the start of the stage), and
+/// the load factor of every prescribed dof and load is solved for at each step; it may fall
+/// (a snap-back) or exceed 1. The stage ends when the control quantity reaches its end.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PathControl {
+    /// Node set name.
+    pub set: String,
+    /// Which component.
+    pub component: Component,
+    /// The control quantity's change over the stage (m or rad).
+    pub value: f64,
+}
+
 /// How a load follows the load factor of its stage.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Ramp {
@@ -105,6 +119,9 @@ pub struct Loading {
     /// Prescribed values of single dofs `(node, component, value at lambda = 1)`, applied
     /// after the set-based ones (for manufactured solutions and analytical profiles).
     pub nodal_dirichlet: Vec<(usize, Component, f64)>,
+    /// Path control: the steps advance this quantity, the load factor follows (`None`: the
+    /// steps advance the load factor).
+    pub control: Option<PathControl>,
 }
 
 /// The loading turned into global vectors for one mesh and dof map.

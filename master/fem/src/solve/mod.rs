@@ -1,6 +1,7 @@
 //! The nonlinear solve: loading, sparse linear solves, Newton-Raphson with line search and
 //! load-step cutting, and the per-step observer.
 
+mod control;
 mod follower;
 mod linear;
 mod loading;
@@ -14,7 +15,7 @@ mod system;
 
 pub use linear::LinearSolver;
 pub use loading::{
-    BodyLoad, Dirichlet, EdgeLoad, EdgeLoadKind, LoadVectors, Loading, Platens, Ramp,
+    BodyLoad, Dirichlet, EdgeLoad, EdgeLoadKind, LoadVectors, Loading, PathControl, Platens, Ramp,
 };
 pub use observer::{GaussPointState, SolutionView, StepControl, StepObserver, StepReport};
 pub use settings::{MAX_LOAD_STEPS, MIN_INCREMENT_FRACTION, SolverSettings};

@@ -78,13 +78,23 @@ impl Trial {
 
 /// How one attempt at a load step ended.
 pub(super) enum Attempt {
-    Converged { iterations: u32, residuals: Vec<f64>, halvings: u32, tolerated: bool, forced: bool },
+    /// `lambda`: the load factor reached (the target, or under a path control the one
+    /// solved for).
+    Converged {
+        iterations: u32,
+        residuals: Vec<f64>,
+        halvings: u32,
+        tolerated: bool,
+        forced: bool,
+        lambda: f64,
+    },
     Failed(Failure),
 }
 
 impl Solver {
-    /// One attempt at reaching load factor `target` from the converged state; `at_minimum`: the run
-    /// ends if it fails (see
+    /// One attempt at reaching load factor `target` from the converged state, or under a path
+    /// control progress `target` (the load factor then solved for with the dofs);
+    /// `at_minimum`: the run ends if it fails (see
     /// [`SolverSettings::forced_residual`](super::SolverSettings::forced_residual)).
     pub(super) fn attempt(
         &mut self,
@@ -125,7 +135,14 @@ impl Solver {
             },
         };
         let u_n = self.u.clone();
-        let asm = self.assemble(&responses, &u_n, target, Some(&du_c));
+        // Under a path control: the prescribed dofs' rate, and the control quantity's target.
+        let controlled =
+            self.control.as_ref().map(|c| (self.loads.prescribed_rate(), c.target(target)));
+        let mut lambda = if controlled.is_some() { self.lambda } else { target };
+        let asm = match &controlled {
+            Some((g, _)) => self.assemble(&responses, &u_n, lambda, Some(g)),
+            None => self.assemble(&responses, &u_n, target, Some(&du_c)),
+        };
         // Secant updates start from the material's tangent at the step's start (the converged
         // strains are the Gauss-point states').
         let mut secants: Option<Vec<PointSecant>> = self.settings.secant_updates.then(|| {
@@ -136,26 +153,43 @@ impl Solver {
                 .collect()
         });
         self.committed = Some(responses);
-        let (r0, _) = self.residual(&asm.f_int, &self.external(target, &u_n));
-        let mut rhs: Vec<f64> = r0.iter().zip(&asm.k_fc_du).map(|(r, k)| -(r + k)).collect();
-        if let Err(s) = {
-            let _s = tracing::info_span!("predictor").entered();
-            self.linear.solve(&self.values, &mut rhs, symmetric)
-        } {
-            return Ok(Attempt::Failed(Failure::Singular(s)));
-        }
+        let (r0, _) = self.residual(&asm.f_int, &self.external(lambda, &u_n));
         let mut u = u_n.clone();
-        self.add_free(&mut u, &rhs, 1.0);
-        for (x, d) in u.iter_mut().zip(&du_c) {
-            *x += d;
-        }
-        let mut du = rhs;
+        // The load factor's change of the last update (path control only).
+        let mut dl = 0.0;
+        let mut du = if let Some((g, tau)) = &controlled {
+            let _s = tracing::info_span!("predictor").entered();
+            let q = self.lambda_rate(&asm.k_fc_du, &u_n);
+            match self.controlled_correction(&r0, &q, &u_n, g, *tau, symmetric) {
+                Ok((d, l)) => {
+                    self.add_free(&mut u, &d, 1.0);
+                    (lambda, dl) = (lambda + l, l);
+                    self.set_prescribed(&mut u, lambda);
+                    d
+                }
+                Err(f) => return Ok(Attempt::Failed(f)),
+            }
+        } else {
+            let mut rhs: Vec<f64> = r0.iter().zip(&asm.k_fc_du).map(|(r, k)| -(r + k)).collect();
+            if let Err(s) = {
+                let _s = tracing::info_span!("predictor").entered();
+                self.linear.solve(&self.values, &mut rhs, symmetric)
+            } {
+                return Ok(Attempt::Failed(Failure::Singular(s)));
+            }
+            self.add_free(&mut u, &rhs, 1.0);
+            for (x, d) in u.iter_mut().zip(&du_c) {
+                *x += d;
+            }
+            rhs
+        };
         let mut residuals = Vec::new();
-        let mut previous: Option<(Vec<f64>, f64)> = None; // (u before the update, |r| there)
+        // (u before the update, |r| there, the load factor there)
+        let mut previous: Option<(Vec<f64>, f64, f64)> = None;
         let mut last_rel = f64::INFINITY;
-        // The iterate of the attempt with the smallest residual (relative residual, u):
-        // what a tolerated step accepts (see `tolerated_residual`).
-        let mut best: Option<(f64, Vec<f64>)> = None;
+        // The iterate of the attempt with the smallest residual (relative residual, u, load
+        // factor): what a tolerated step accepts (see `tolerated_residual`).
+        let mut best: Option<(f64, Vec<f64>, f64)> = None;
         let mut best_at = 0u32;
         let mut halvings = 0;
         for k in 1..=self.settings.max_iterations + 1 {
@@ -163,11 +197,12 @@ impl Solver {
             let _enter = span.enter();
             let mut alpha = 1.0;
             let Trial { responses, inputs, asm, f_ext, r, scale } = loop {
-                let trial = match self.trial(material, next_trial(iteration), &u, target)? {
+                let rate = controlled.as_ref().map(|(g, _)| g.as_slice());
+                let trial = match self.trial(material, next_trial(iteration), &u, lambda, rate)? {
                     Ok(t) => t,
                     Err(f) => return Ok(Attempt::Failed(f)),
                 };
-                let grows = previous.as_ref().is_some_and(|(_, rp)| norm(&trial.r) > *rp);
+                let grows = previous.as_ref().is_some_and(|(_, rp, _)| norm(&trial.r) > *rp);
                 let can_cut = self.settings.line_search
                     && grows
                     && alpha > 0.5f64.powi(self.settings.max_line_search as i32);
@@ -176,9 +211,14 @@ impl Solver {
                 }
                 alpha *= 0.5;
                 halvings += 1;
-                let (u_prev, _) = previous.as_ref().expect("grows implies a previous iterate");
+                let (u_prev, _, l_prev) =
+                    previous.as_ref().expect("grows implies a previous iterate");
                 u.clone_from(u_prev);
                 self.add_free(&mut u, &du, alpha);
+                if controlled.is_some() {
+                    lambda = l_prev + alpha * dl;
+                    self.set_prescribed(&mut u, lambda);
+                }
                 tracing::debug!(alpha, "line search");
             };
             let rn = norm(&r);
@@ -221,25 +261,28 @@ impl Solver {
                     halvings,
                     tolerated: false,
                     forced: false,
+                    lambda,
                 });
             }
             // Only a tolerated step uses the best iterate: without one, no copy of `u`.
             let tolerating = accepted > 0.0;
-            if tolerating && best.as_ref().is_none_or(|(b, _)| rel < *b) {
-                best = Some((rel, u.clone()));
+            if tolerating && best.as_ref().is_none_or(|(b, _, _)| rel < *b) {
+                best = Some((rel, u.clone(), lambda));
                 best_at = k;
             }
-            let tolerated = best.as_ref().is_some_and(|(b, _)| *b <= accepted);
+            let tolerated = best.as_ref().is_some_and(|(b, _, _)| *b <= accepted);
             let stall = self.settings.stall_iterations;
             // The stall ends only an attempt tolerated without the forced residual: one
             // forced early could have come within the tolerated residual later.
-            let within = best.as_ref().is_some_and(|(b, _)| *b <= tolerated_residual);
+            let within = best.as_ref().is_some_and(|(b, _, _)| *b <= tolerated_residual);
             let stalled = stall > 0 && within && k - best_at >= stall;
             if stalled {
                 tracing::debug!(iterations = k, since = best_at, "stalled");
             }
             if k > self.settings.max_iterations || stalled {
-                let Some((_, best_u)) = best.take().filter(|_| tolerated) else { break };
+                let Some((_, best_u, best_lambda)) = best.take().filter(|_| tolerated) else {
+                    break;
+                };
                 let (u, trial) = if best_at == k {
                     (u, Trial { responses, inputs, asm, f_ext, r, scale })
                 } else {
@@ -247,11 +290,12 @@ impl Solver {
                     // so the best one is evaluated again (from the committed state: the same
                     // answer unless the material warm-starts) and accepted if it is still
                     // tolerated.
-                    let trial =
-                        match self.trial(material, next_trial(iteration), &best_u, target)? {
-                            Ok(t) => t,
-                            Err(f) => return Ok(Attempt::Failed(f)),
-                        };
+                    let rate = controlled.as_ref().map(|(g, _)| g.as_slice());
+                    let id = next_trial(iteration);
+                    let trial = match self.trial(material, id, &best_u, best_lambda, rate)? {
+                        Ok(t) => t,
+                        Err(f) => return Ok(Attempt::Failed(f)),
+                    };
                     last_rel = trial.relative();
                     residuals.push(last_rel);
                     if last_rel > accepted {
@@ -266,6 +310,7 @@ impl Solver {
                     halvings,
                     tolerated: true,
                     forced: last_rel > tolerated_residual,
+                    lambda: best_lambda,
                 });
             }
             // An iteration that did not contract ends the secant updates of this attempt: the
@@ -283,13 +328,26 @@ impl Solver {
                     p.advance(self.strain_of(&i.deformation), r.stress);
                     r.tangent = p.matrix;
                 }
-                self.assemble(&updated, &u, target, None);
+                self.assemble(&updated, &u, lambda, None);
+            }
+            if let Some((g, tau)) = &controlled {
+                let q = self.lambda_rate(&asm.k_fc_du, &u);
+                let (d, l) = match self.controlled_correction(&r, &q, &u, g, *tau, symmetric) {
+                    Ok(c) => c,
+                    Err(f) => return Ok(Attempt::Failed(f)),
+                };
+                previous = Some((u.clone(), rn, lambda));
+                self.add_free(&mut u, &d, 1.0);
+                (lambda, dl) = (lambda + l, l);
+                self.set_prescribed(&mut u, lambda);
+                du = d;
+                continue;
             }
             let mut rhs: Vec<f64> = r.iter().map(|x| -x).collect();
             if let Err(s) = self.linear.solve(&self.values, &mut rhs, symmetric) {
                 return Ok(Attempt::Failed(Failure::Singular(s)));
             }
-            previous = Some((u.clone(), rn));
+            previous = Some((u.clone(), rn, lambda));
             self.add_free(&mut u, &rhs, 1.0);
             du = rhs;
         }
@@ -307,6 +365,56 @@ impl Solver {
             }
         }
         (f64::sqrt(t), f64::sqrt(w))
+    }
+
+    /// Path control: the residual's rate in the load factor on the free rows,
+    /// `q = K_fc g - d f_ext / d lambda`, from `k_fc_g = K_fc g` (the loads are affine in the
+    /// load factor, so the difference of the external forces at 1 and 0 is their rate).
+    fn lambda_rate(&self, k_fc_g: &[f64], u: &[f64]) -> Vec<f64> {
+        let (f1, f0) = (self.external(1.0, u), self.external(0.0, u));
+        let mut q = k_fc_g.to_vec();
+        for (d, &eq) in self.dofs.equation.iter().enumerate() {
+            if eq != usize::MAX {
+                q[eq] -= f1[d] - f0[d];
+            }
+        }
+        q
+    }
+
+    /// Path control: the correction `(du_f, dlambda)` of the iterate `u` with residual `r`
+    /// and rate `q` that meets the control's constraint `tau = tau_target` (module
+    /// [`super::control`]).
+    fn controlled_correction(
+        &mut self,
+        r: &[f64],
+        q: &[f64],
+        u: &[f64],
+        g: &[f64],
+        tau_target: f64,
+        symmetric: bool,
+    ) -> std::result::Result<(Vec<f64>, f64), Failure> {
+        let n = r.len();
+        let mut rhs: Vec<f64> = r.iter().chain(q).map(|x| -x).collect();
+        self.linear
+            .solve_columns(&self.values, &mut rhs, n, symmetric)
+            .map_err(Failure::Singular)?;
+        let (a, b) = rhs.split_at(n);
+        let control = self.control.as_ref().expect("a path-controlled attempt has a control");
+        let dl = control.correction(&self.dofs, u, a, b, g, tau_target).ok_or_else(|| {
+            Failure::Singular(
+                "the path control's quantity does not move with the load factor".into(),
+            )
+        })?;
+        Ok((a.iter().zip(b).map(|(a, b)| a + dl * b).collect(), dl))
+    }
+
+    /// Sets every prescribed dof of `u` to its value at load factor `lambda`.
+    fn set_prescribed(&self, u: &mut [f64], lambda: f64) {
+        for (k, x) in u.iter_mut().enumerate() {
+            if self.loads.prescribed[k] {
+                *x = self.loads.prescribed_at(k, lambda);
+            }
+        }
     }
 
     /// `u[free] += alpha * du[eq]`.

@@ -17,10 +17,12 @@ pub struct StepReport {
     pub stage: u32,
     /// Load factor reached within the stage (1 = the stage's full loading).
     pub load_factor: f64,
-    /// Pseudo-time: stages finished before this step plus its load factor (increasing over
-    /// the whole run; equal to `load_factor` in a one-stage job).
+    /// Pseudo-time: stages finished before this step plus its load factor, or under a path
+    /// control its progress (increasing over the whole run; equal to `load_factor` in a
+    /// one-stage job without a path control).
     pub time: f64,
-    /// Load factor increment of this step (after any cuts).
+    /// Load factor increment of this step (after any cuts); under a path control, the
+    /// progress's.
     pub increment: f64,
     /// Newton iterations of the successful attempt (solves after the predictor).
     pub iterations: u32,

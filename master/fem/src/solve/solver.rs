@@ -6,6 +6,7 @@
 //! [`Solver::run`] loops over load steps; each step is a predictor plus Newton iterations,
 //! then `commit`, reactions and the observer call.
 
+use super::control::ControlDofs;
 use super::follower::Followers;
 use super::linear::LinearSolver;
 use super::loading::{LoadVectors, Loading};
@@ -57,6 +58,8 @@ pub struct SolverState {
     /// Every dof's value at the start of that stage (`None` in the first stage): what its
     /// prescribed dofs move from ([`Solver::resume_stage`]).
     pub stage_start: Option<Vec<f64>>,
+    /// Converged progress of a path-controlled stage (0 to 1; 0 without a path control).
+    pub progress: f64,
 }
 
 /// The whole run's step reports.
@@ -84,6 +87,10 @@ pub struct Solver {
     pub(super) u: Vec<f64>,
     /// Converged load factor.
     pub(super) lambda: f64,
+    /// The stage's path control, if any ([`super::control`]).
+    pub(super) control: Option<ControlDofs>,
+    /// Converged progress of a path-controlled stage (0 to 1): what its steps advance.
+    pub(super) progress: f64,
     /// Converged steps so far.
     pub(super) step: u64,
     /// The stage being run (0-based; see [`Solver::begin_stage`]).
@@ -121,6 +128,7 @@ impl Solver {
         let (loads, followers) = Self::load_vectors(&model, &model.loading, &dofs, &gauss, None)?;
         let pattern = Pattern::new(&model.mesh, &dofs);
         let linear = LinearSolver::new(&pattern)?;
+        let control = Self::control_of(&model, &model.loading, None)?;
         let states = (0..gauss.len())
             .map(|g| GaussPointState {
                 id: gauss.id(g),
@@ -152,6 +160,8 @@ impl Solver {
             loads,
             followers,
             lambda: 0.0,
+            control,
+            progress: 0.0,
             step: 0,
             stage: 0,
             saved_stage_start: None,
@@ -181,6 +191,26 @@ impl Solver {
                 Followers::new(loading, &model.mesh)?,
             )),
         }
+    }
+
+    /// The path control of `loading`, resolved on the model's mesh from the dof values
+    /// `start` of the stage.
+    pub(super) fn control_of(
+        model: &Model,
+        loading: &Loading,
+        start: Option<&[f64]>,
+    ) -> Result<Option<ControlDofs>> {
+        loading
+            .control
+            .as_ref()
+            .map(|c| ControlDofs::new(c, &model.mesh, model.field, start))
+            .transpose()
+    }
+
+    /// Where the stage stands: the converged progress of a path-controlled stage, else the
+    /// converged load factor (both 1 at the stage's end).
+    pub(super) fn position(&self) -> f64 {
+        if self.control.is_some() { self.progress } else { self.lambda }
     }
 
     /// The model.
@@ -243,6 +273,7 @@ impl Solver {
             reactions: self.reactions.clone(),
             stage: self.stage,
             stage_start: self.loads.prescribed_start.clone(),
+            progress: self.progress,
         }
     }
 
@@ -271,7 +302,14 @@ impl Solver {
         {
             return Err(bad("checkpoint.committed", c.len(), self.states.len()));
         }
-        if !(state.increment > 0.0 && state.lambda >= 0.0) {
+        if !(state.progress.is_finite() && (0.0..=1.0).contains(&state.progress)) {
+            return Err(Error::InvalidSetting {
+                field: "checkpoint.progress",
+                value: state.progress.to_string(),
+                reason: "must be in [0, 1]".into(),
+            });
+        }
+        if !(state.increment > 0.0 && (state.lambda >= 0.0 || self.control.is_some())) {
             return Err(Error::InvalidSetting {
                 field: "checkpoint.increment",
                 value: state.increment.to_string(),
@@ -280,6 +318,7 @@ impl Solver {
         }
         self.u = state.u;
         self.lambda = state.lambda;
+        self.progress = state.progress;
         self.step = state.step;
         self.increment = state.increment;
         self.committed = state.committed;
@@ -312,34 +351,47 @@ impl Solver {
         // Ends: every pass either converges (the load factor grows by at least the minimum
         // increment, checked below) or cuts the increment, and at most log2(1 /
         // min_increment_fraction) + 1 cuts in a row end the run with StepTooSmall.
-        while self.lambda < 1.0 - 1e-12 {
-            let target = (self.lambda + self.increment).min(1.0);
+        let controlled = self.control.is_some();
+        while self.position() < 1.0 - 1e-12 {
+            // The load factor's target, or with a path control the progress's.
+            let position = self.position();
+            let target = (position + self.increment).min(1.0);
             let step = self.step + 1;
-            if target <= self.lambda {
+            if target <= position {
                 return Err(Error::InvalidSetting {
                     field: "min_increment_fraction",
                     value: self.settings.min_increment_fraction.to_string(),
                     reason: format!(
                         "the increment {:e} no longer moves the load factor \
                          {:.17}: raise it",
-                        self.increment, self.lambda
+                        self.increment, position
                     ),
                 });
             }
             let span = tracing::info_span!("load_step", step, lambda = target);
             let _enter = span.enter();
             // The last attempt before the run would end: halving it goes below the minimum.
-            let at_minimum = 0.5 * (target - self.lambda) < min_increment * (1.0 - 1e-9);
+            let at_minimum = 0.5 * (target - position) < min_increment * (1.0 - 1e-9);
             match self.attempt(material, step, &mut iteration, target, at_minimum)? {
-                Attempt::Converged { iterations, residuals, halvings, tolerated, forced } => {
+                Attempt::Converged {
+                    iterations,
+                    residuals,
+                    halvings,
+                    tolerated,
+                    forced,
+                    lambda,
+                } => {
                     material.commit(step)?;
-                    let done = target - self.lambda;
-                    self.lambda = target;
+                    let done = target - position;
+                    self.lambda = lambda;
+                    if controlled {
+                        self.progress = target;
+                    }
                     self.step = step;
                     let report = StepReport {
                         step,
                         stage: self.stage,
-                        load_factor: target,
+                        load_factor: lambda,
                         time: f64::from(self.stage) + target,
                         increment: done,
                         iterations,
@@ -382,7 +434,7 @@ impl Solver {
                 }
                 Attempt::Failed(failure) => {
                     material.rollback()?;
-                    let tried = target - self.lambda;
+                    let tried = target - position;
                     tracing::warn!(
                         reason = failure.reason(),
                         increment = tried,
@@ -394,7 +446,11 @@ impl Solver {
                         return Err(Error::StepTooSmall {
                             step,
                             load_factor: self.lambda,
-                            displacement: self.largest_prescribed(target),
+                            displacement: self.largest_prescribed(if controlled {
+                                self.lambda
+                            } else {
+                                target
+                            }),
                             increment: tried,
                             min_increment,
                             reason: failure.reason(),

@@ -24,13 +24,13 @@ impl Solver {
     /// finished (load factor 1): `loading` with `steps` nominal equal steps. Relative
     /// prescribed values count from the dofs' current values.
     pub fn begin_stage(&mut self, loading: Loading, steps: usize) -> Result<()> {
-        if self.lambda < 1.0 - 1e-12 {
+        if self.position() < 1.0 - 1e-12 {
             return Err(Error::InvalidSetting {
                 field: "stage",
                 value: (self.stage + 1).to_string(),
                 reason: format!(
-                    "stage {} is not finished (load factor {}): a stage starts after the last step of the one before",
-                    self.stage, self.lambda
+                    "stage {} is not finished (load factor {}, progress {}): a stage starts after the last step of the one before",
+                    self.stage, self.lambda, self.progress
                 ),
             });
         }
@@ -38,6 +38,7 @@ impl Solver {
         self.install(loading, steps, start)?;
         self.stage += 1;
         self.lambda = 0.0;
+        self.progress = 0.0;
         self.increment = 1.0 / steps as f64;
         Ok(())
     }
@@ -78,6 +79,7 @@ impl Solver {
         } else {
             Some(DofMap::new(field, self.model.mesh.n_nodes(), &prescribed))
         };
+        let control = Self::control_of(&self.model, &loading, Some(&start))?;
         let (loads, followers) = Self::load_vectors(
             &self.model,
             &loading,
@@ -95,6 +97,7 @@ impl Solver {
         }
         self.loads = loads;
         self.followers = followers;
+        self.control = control;
         self.model.loading = loading;
         self.settings = settings;
         Ok(())

@@ -139,19 +139,20 @@ impl Solver {
     }
 
     /// Evaluates the material at `u` and assembles residual and matrix there, at load factor
-    /// `lambda`.
+    /// `lambda`; with `rate` (a path control's prescribed-dof rate) also `K_fc rate`.
     pub(super) fn trial(
         &mut self,
         material: &mut dyn Material,
         trial: TrialId,
         u: &[f64],
         lambda: f64,
+        rate: Option<&[f64]>,
     ) -> Result<std::result::Result<Trial, Failure>> {
         let (responses, inputs) = match self.evaluate(material, trial, u)? {
             Ok(e) => e,
             Err(f) => return Ok(Err(f)),
         };
-        let asm = self.assemble(&responses, u, lambda, None);
+        let asm = self.assemble(&responses, u, lambda, rate);
         let f_ext = self.external(lambda, u);
         let (r, scale) = self.residual(&asm.f_int, &f_ext);
         Ok(Ok(Trial { responses, inputs, asm, f_ext, r, scale }))

@@ -179,7 +179,10 @@ impl Job {
         force: &mut InForce,
         element_materials: Option<&Arc<Vec<usize>>>,
     ) -> Result<Loading> {
-        let mut loading = Loading::default();
+        let mut loading = Loading {
+            control: stage.control.as_ref().map(crate::schema::ControlSection::path_control),
+            ..Default::default()
+        };
         // Held dofs first: the stage's own entries come later and win.
         let named: Vec<(String, Component)> =
             stage.prescribed.iter().map(|p| (p.set.clone(), component(p.component))).collect();
@@ -371,6 +374,9 @@ impl Job {
             if mesh.edge_sets.get(set).is_none_or(Vec::is_empty) {
                 return Err(unknown(key(i, &at), set, "edge", mesh.edge_sets.keys().collect()));
             }
+        }
+        if let Some(c) = &s.control {
+            crate::convert::check_control(&format!("stage[{i}].control"), c, mesh)?;
         }
         Ok(())
     }

@@ -132,6 +132,9 @@ pub struct StageSection {
     pub traction: Vec<StageTraction>,
     /// Self-weight.
     pub gravity: Option<StageGravity>,
+    /// Path control: the stage's steps advance a set's mean displacement, its load factor
+    /// follows (`[loading.control]`'s meaning).
+    pub control: Option<crate::schema::ControlSection>,
 }
 
 fn default_steps() -> usize {
