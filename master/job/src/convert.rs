@@ -219,6 +219,30 @@ impl Job {
     }
 }
 
+/// A path control's node set must be a non-empty set of the mesh and its value finite and
+/// not zero (`at`: the control's key, `loading.control` or `stage[i].control`).
+pub(crate) fn check_control(at: &str, c: &ControlSection, mesh: &Mesh) -> Result<()> {
+    let field = |rest: &str| crate::validate::interned(format!("{at}.{rest}"));
+    if mesh.node_sets.get(&c.set).is_none_or(Vec::is_empty) {
+        return Err(Error::InvalidSetting {
+            field: field("set"),
+            value: c.set.clone(),
+            reason: format!(
+                "the mesh has no non-empty node set of that name (known: {})",
+                mesh.node_sets.keys().cloned().collect::<Vec<_>>().join(", ")
+            ),
+        });
+    }
+    if !(c.value.is_finite() && c.value != 0.0) {
+        return Err(Error::InvalidSetting {
+            field: field("value"),
+            value: c.value.to_string(),
+            reason: "must be finite and not zero (the control quantity's change)".into(),
+        });
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use crate::{Continuum, ElementChoice, Integration, Job, fixtures};
@@ -290,28 +314,4 @@ mod tests {
         assert_eq!(top.unwrap().value, -0.005);
         assert_eq!(bottom.unwrap().value, 0.005);
     }
-}
-
-/// A path control's node set must be a non-empty set of the mesh and its value finite and
-/// not zero (`at`: the control's key, `loading.control` or `stage[i].control`).
-pub(crate) fn check_control(at: &str, c: &ControlSection, mesh: &Mesh) -> Result<()> {
-    let field = |rest: &str| crate::validate::interned(format!("{at}.{rest}"));
-    if mesh.node_sets.get(&c.set).is_none_or(Vec::is_empty) {
-        return Err(Error::InvalidSetting {
-            field: field("set"),
-            value: c.set.clone(),
-            reason: format!(
-                "the mesh has no non-empty node set of that name (known: {})",
-                mesh.node_sets.keys().cloned().collect::<Vec<_>>().join(", ")
-            ),
-        });
-    }
-    if !(c.value.is_finite() && c.value != 0.0) {
-        return Err(Error::InvalidSetting {
-            field: field("value"),
-            value: c.value.to_string(),
-            reason: "must be finite and not zero (the control quantity's change)".into(),
-        });
-    }
-    Ok(())
 }

@@ -49,8 +49,8 @@ pub use load::MAX_JOB_FILE_BYTES;
 pub use packing_file::MAX_PACKING_FILE_BYTES;
 pub use region::RegionSection;
 pub use schema::{
-    ComponentChoice, Compression, Continuum, ElementChoice, Integration, Job, LoadingSection,
-    MaterialSection, MeshKind, MeshSection, Moving, NewtonSection, OutputSection,
+    ComponentChoice, Compression, Continuum, ControlSection, ElementChoice, Integration, Job,
+    LoadingSection, MaterialSection, MeshKind, MeshSection, Moving, NewtonSection, OutputSection,
     PAPER_LINEAR_RANGE, PlatenChoice, Prescribed, PressureLoad, RampChoice, VtkFormat,
     WorkersSection,
 };

@@ -341,6 +341,11 @@ fn a_stepper_checkpoint_keeps_its_stages_and_a_runs_keeps_its_bytes() {
             density: None,
             ramp: StageRamp::Constant,
         }),
+        control: (i == 2).then(|| cosdem_job::ControlSection {
+            set: "left".into(),
+            component: ComponentChoice::Ux,
+            value: awkward_values[4],
+        }),
     };
     let stepper = Checkpoint { stages: Some((0..3).map(stage).collect()), ..awkward() };
     stepper.write(&path).unwrap();

@@ -110,6 +110,7 @@ impl ControlDofs {
             }
         }
         let dl = (tau_target - self.tau(u) - ca) / rate;
+        tracing::debug!(c_a = ca, rate, "path control terms");
         (rate != 0.0 && dl.is_finite()).then_some(dl)
     }
 }

@@ -405,6 +405,7 @@ impl Solver {
                 "the path control's quantity does not move with the load factor".into(),
             )
         })?;
+        tracing::debug!(dlambda = dl, tau = control.tau(u), tau_target, "path control");
         Ok((a.iter().zip(b).map(|(a, b)| a + dl * b).collect(), dl))
     }
 
