@@ -240,6 +240,25 @@ pub(crate) fn check_control(at: &str, c: &ControlSection, mesh: &Mesh) -> Result
             reason: "must be finite and not zero (the control quantity's change)".into(),
         });
     }
+    for (j, t) in c.plus.iter().enumerate() {
+        if mesh.node_sets.get(&t.set).is_none_or(Vec::is_empty) {
+            return Err(Error::InvalidSetting {
+                field: field(&format!("plus[{j}].set")),
+                value: t.set.clone(),
+                reason: format!(
+                    "the mesh has no non-empty node set of that name (known: {})",
+                    mesh.node_sets.keys().cloned().collect::<Vec<_>>().join(", ")
+                ),
+            });
+        }
+        if !t.weight.is_finite() {
+            return Err(Error::InvalidSetting {
+                field: field(&format!("plus[{j}].weight")),
+                value: t.weight.to_string(),
+                reason: "must be finite".into(),
+            });
+        }
+    }
     Ok(())
 }
 

@@ -49,10 +49,10 @@ pub use load::MAX_JOB_FILE_BYTES;
 pub use packing_file::MAX_PACKING_FILE_BYTES;
 pub use region::RegionSection;
 pub use schema::{
-    ComponentChoice, Compression, Continuum, ControlSection, ElementChoice, Integration, Job,
-    LoadingSection, MaterialSection, MeshKind, MeshSection, Moving, NewtonSection, OutputSection,
-    PAPER_LINEAR_RANGE, PlatenChoice, Prescribed, PressureLoad, RampChoice, VtkFormat,
-    WorkersSection,
+    ComponentChoice, Compression, Continuum, ControlSection, ControlTermSection, ElementChoice,
+    Integration, Job, LoadingSection, MaterialSection, MeshKind, MeshSection, Moving,
+    NewtonSection, OutputSection, PAPER_LINEAR_RANGE, PlatenChoice, Prescribed, PressureLoad,
+    RampChoice, VtkFormat, WorkersSection,
 };
 pub use specimens::{Consolidation, SpecimenCount, SpecimensSection};
 pub use stage::{

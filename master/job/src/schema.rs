@@ -223,8 +223,24 @@ pub struct ControlSection {
     pub set: String,
     /// `ux`, `uy` or `w`.
     pub component: ComponentChoice,
-    /// The change of the set's mean `component` over the run or stage (m or rad; not 0).
+    /// The change of the control quantity over the run or stage (m or rad; not 0).
     pub value: f64,
+    /// Further terms: the control quantity is the set's mean `component` plus each term's
+    /// `weight` times its set's mean `component`.
+    #[serde(default)]
+    pub plus: Vec<ControlTermSection>,
+}
+
+/// One of `[loading.control] plus`: `weight` times the mean of `component` over `set`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ControlTermSection {
+    /// Node set.
+    pub set: String,
+    /// `ux`, `uy` or `w`.
+    pub component: ComponentChoice,
+    /// Weight (finite).
+    pub weight: f64,
 }
 
 impl ControlSection {
@@ -234,6 +250,15 @@ impl ControlSection {
             set: self.set.clone(),
             component: self.component.into(),
             value: self.value,
+            plus: self
+                .plus
+                .iter()
+                .map(|t| cosdem_fem::solve::ControlTerm {
+                    set: t.set.clone(),
+                    component: t.component.into(),
+                    weight: t.weight,
+                })
+                .collect(),
         }
     }
 }

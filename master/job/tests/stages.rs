@@ -306,4 +306,14 @@ fn path_controls_reach_the_loading_and_unknown_sets_are_refused() {
     assert!(e.to_string().contains("loading.control.value"), "{e}");
     let e = plain("set = \"left\"\ncomponent = \"ux\"\n").unwrap_err();
     assert!(e.contains("value"), "{e}");
+    // A combination: the top's mean u_y minus twice the left side's mean u_x.
+    let both = "set = \"top\"\ncomponent = \"uy\"\nvalue = -1e-3\n\
+                plus = [{ set = \"left\", component = \"ux\", weight = -2.0 }]\n";
+    let c = plain(both).unwrap().model().unwrap().loading.control.expect("the job's control");
+    assert_eq!(c.plus.len(), 1);
+    let term = &c.plus[0];
+    assert_eq!((term.set.as_str(), term.component, term.weight), ("left", Component::Ux, -2.0));
+    let flank = both.replace("\"left\"", "\"flank\"");
+    let e = plain(&flank).unwrap().model().unwrap_err().to_string();
+    assert!(e.contains("loading.control.plus[0].set") && e.contains("flank"), "{e}");
 }

@@ -345,6 +345,11 @@ fn a_stepper_checkpoint_keeps_its_stages_and_a_runs_keeps_its_bytes() {
             set: "left".into(),
             component: ComponentChoice::Ux,
             value: awkward_values[4],
+            plus: vec![cosdem_job::ControlTermSection {
+                set: "top".into(),
+                component: ComponentChoice::Uy,
+                weight: awkward_values[3],
+            }],
         }),
     };
     let stepper = Checkpoint { stages: Some((0..3).map(stage).collect()), ..awkward() };

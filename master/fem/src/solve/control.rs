@@ -17,7 +17,7 @@
 //! The constraint is linear, so a full update meets it to round-off; a line-search halving
 //! leaves part of it for the next iteration (the correction measures `tau_target - tau(u)`).
 
-use super::loading::{LoadVectors, PathControl};
+use super::loading::{ControlTerm, LoadVectors, PathControl};
 use crate::assembly::{DofMap, Field};
 use crate::error::{Error, Result};
 use crate::mesh::Mesh;
@@ -43,13 +43,6 @@ impl ControlDofs {
         field: Field,
         start: Option<&[f64]>,
     ) -> Result<Self> {
-        if field == Field::Cauchy && control.component.offset() == 2 {
-            return Err(Error::InvalidSetting {
-                field: "control.component",
-                value: format!("w on `{}`", control.set),
-                reason: "the Cauchy field has no micro-rotation".into(),
-            });
-        }
         if !(control.value.is_finite() && control.value != 0.0) {
             return Err(Error::InvalidSetting {
                 field: "control.value",
@@ -59,18 +52,45 @@ impl ControlDofs {
                     .into(),
             });
         }
-        let nodes = mesh.node_set(&control.set)?;
-        if nodes.is_empty() {
-            return Err(Error::InvalidSetting {
-                field: "control.set",
-                value: control.set.clone(),
-                reason: "the node set is empty".into(),
-            });
+        let primary =
+            ControlTerm { set: control.set.clone(), component: control.component, weight: 1.0 };
+        let mut weights = Vec::new();
+        for (i, term) in std::iter::once(&primary).chain(&control.plus).enumerate() {
+            let at = |rest: &str| -> &'static str {
+                match (i, rest) {
+                    (0, "set") => "control.set",
+                    (0, _) => "control.component",
+                    (_, "set") => "control.plus.set",
+                    (_, "weight") => "control.plus.weight",
+                    _ => "control.plus.component",
+                }
+            };
+            if field == Field::Cauchy && term.component.offset() == 2 {
+                return Err(Error::InvalidSetting {
+                    field: at("component"),
+                    value: format!("w on `{}`", term.set),
+                    reason: "the Cauchy field has no micro-rotation".into(),
+                });
+            }
+            if !term.weight.is_finite() {
+                return Err(Error::InvalidSetting {
+                    field: at("weight"),
+                    value: term.weight.to_string(),
+                    reason: "must be finite".into(),
+                });
+            }
+            let nodes = mesh.node_set(&term.set)?;
+            if nodes.is_empty() {
+                return Err(Error::InvalidSetting {
+                    field: at("set"),
+                    value: term.set.clone(),
+                    reason: "the node set is empty".into(),
+                });
+            }
+            let w = term.weight / nodes.len() as f64;
+            let ndf = field.ndf();
+            weights.extend(nodes.iter().map(|&n| (n * ndf + term.component.offset(), w)));
         }
-        let w = 1.0 / nodes.len() as f64;
-        let ndf = field.ndf();
-        let weights: Vec<(usize, f64)> =
-            nodes.iter().map(|&n| (n * ndf + control.component.offset(), w)).collect();
         let start = start.map_or(0.0, |u| weights.iter().map(|&(d, w)| w * u[d]).sum());
         Ok(Self { weights, start, value: control.value })
     }

@@ -48,6 +48,21 @@ pub struct PathControl {
     pub component: Component,
     /// The control quantity's change over the stage (m or rad).
     pub value: f64,
+    /// Further terms of the control quantity: it is the mean of `component` over `set` plus
+    /// each term's weighted mean (a combination such as a platen's displacement plus a
+    /// multiple of a side's bulge).
+    pub plus: Vec<ControlTerm>,
+}
+
+/// A term of a [`PathControl`]'s quantity: `weight` times the mean of `component` over `set`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ControlTerm {
+    /// Node set name.
+    pub set: String,
+    /// Which component.
+    pub component: Component,
+    /// Its weight (finite).
+    pub weight: f64,
 }
 
 /// How a load follows the load factor of its stage.

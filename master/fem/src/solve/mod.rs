@@ -15,7 +15,8 @@ mod system;
 
 pub use linear::LinearSolver;
 pub use loading::{
-    BodyLoad, Dirichlet, EdgeLoad, EdgeLoadKind, LoadVectors, Loading, PathControl, Platens, Ramp,
+    BodyLoad, ControlTerm, Dirichlet, EdgeLoad, EdgeLoadKind, LoadVectors, Loading, PathControl,
+    Platens, Ramp,
 };
 pub use observer::{GaussPointState, SolutionView, StepControl, StepObserver, StepReport};
 pub use settings::{MAX_LOAD_STEPS, MIN_INCREMENT_FRACTION, SolverSettings};
