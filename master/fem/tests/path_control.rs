@@ -114,24 +114,8 @@ fn bar(top_uy: f64, control: Option<f64>) -> (Model, Bar) {
     (model, Bar { weak })
 }
 
-/// The closed form at control value `tau`: the stress and the top's displacement.
-fn closed_form(tau: f64) -> (f64, f64) {
-    let (s, _) = soft(tau / H);
-    (s, tau + (L - H) * s / E_S)
-}
-
-/// Controlled by the soft element's elongation to 5 e0 (past the peak at e0 and the turn of
-/// the path at about 1.3 e0) in 24 steps (no step lands on the peak itself, where the soft
-/// element's tangent is zero and its inner nodes' stiffness singular), every step meets the closed form: the stress to
-/// 1e-9 of the peak stress and the top's displacement to 1e-12 m (the equations are solved
-/// to a relative residual of 1e-12, and the constraint, linear, is met to round-off), and
-/// the top's displacement rises and then falls (the path the top's own displacement
-/// cannot follow).
-#[test]
-fn the_controlled_path_follows_the_snap_back_of_a_softening_bar() {
-    let u_top = 0.02; // the top's displacement at lambda = 1 (the path never reaches it)
-    let tau_end = 5.0 * E0 * H;
-    let (model, mut material) = bar(u_top, Some(tau_end));
+/// Runs a controlled bar in 24 steps, solved to a relative residual of 1e-12.
+fn run_controlled(model: Model, material: &mut Bar) -> (Solver, Vec<StepReport>) {
     let settings = SolverSettings {
         steps: 24,
         force_tolerance: 1e-12,
@@ -140,7 +124,29 @@ fn the_controlled_path_follows_the_snap_back_of_a_softening_bar() {
     };
     let mut solver = Solver::new(model, settings).unwrap();
     let mut log: Vec<StepReport> = Vec::new();
-    solver.run(&mut material, &mut log).unwrap();
+    solver.run(material, &mut log).unwrap();
+    (solver, log)
+}
+
+/// The closed form at control value `tau`: the stress and the top's displacement.
+fn closed_form(tau: f64) -> (f64, f64) {
+    let (s, _) = soft(tau / H);
+    (s, tau + (L - H) * s / E_S)
+}
+
+/// Controlled by the soft element's elongation to 5 e0 (past the peak at e0 and the turn of
+/// the path at about 1.3 e0) in 24 steps (no step lands on the peak itself, where the soft
+/// element's tangent is zero and its inner nodes' stiffness singular), every step meets the
+/// closed form: the stress to 1e-9 of the peak stress and the top's displacement to 1e-12 m
+/// (the equations are solved to a relative residual of 1e-12, and the constraint, linear,
+/// is met to round-off), and the top's displacement rises and then falls (the path the
+/// top's own displacement cannot follow).
+#[test]
+fn the_controlled_path_follows_the_snap_back_of_a_softening_bar() {
+    let u_top = 0.02; // the top's displacement at lambda = 1 (the path never reaches it)
+    let tau_end = 5.0 * E0 * H;
+    let (model, mut material) = bar(u_top, Some(tau_end));
+    let (solver, log) = run_controlled(model, &mut material);
     assert_eq!(log.len(), 24, "no cuts expected on the smooth law");
     let peak = E * E0 / std::f64::consts::E;
     let mut tops = Vec::new();
@@ -177,15 +183,7 @@ fn a_combined_control_quantity_follows_the_snap_back_too() {
     let (mut model, mut material) = bar(u_top, Some(tau_end));
     let control = model.loading.control.as_mut().unwrap();
     control.plus = vec![ControlTerm { set: "top".into(), component: Component::Uy, weight: 1.0 }];
-    let settings = SolverSettings {
-        steps: 24,
-        force_tolerance: 1e-12,
-        max_iterations: 30,
-        ..Default::default()
-    };
-    let mut solver = Solver::new(model, settings).unwrap();
-    let mut log: Vec<StepReport> = Vec::new();
-    solver.run(&mut material, &mut log).unwrap();
+    let (_, log) = run_controlled(model, &mut material);
     let peak = E * E0 / std::f64::consts::E;
     let mut tops = Vec::new();
     for (k, step) in log.iter().enumerate() {

@@ -268,6 +268,14 @@ impl Job {
             let Some(c) = &l.compression else {
                 return Err(bad("loading.increment", num(inc), "needs [loading.compression]"));
             };
+            if l.control.is_some() {
+                return Err(bad(
+                    "loading.increment",
+                    num(inc),
+                    "a path-controlled run ([loading.control]) divides the control's value \
+                     into `steps`: give `steps`, not a displacement increment",
+                ));
+            }
             if c.displacement / inc > MAX_LOAD_STEPS as f64 {
                 return Err(bad(
                     "loading.increment",

@@ -313,6 +313,19 @@ fn path_controls_reach_the_loading_and_unknown_sets_are_refused() {
     assert_eq!(c.plus.len(), 1);
     let term = &c.plus[0];
     assert_eq!((term.set.as_str(), term.component, term.weight), ("left", Component::Ux, -2.0));
+    // `increment` counts steps in the compression's displacement: refused with a control.
+    let e = Job::from_toml(
+        &format!(
+            "[mesh]\nkind = \"rectangle\"\nlx = 1.0\nly = 1.0\nnx = 2\nny = 2\n\n\
+             [material]\nkind = \"elastic\"\nshear_modulus = 1e7\npoisson = 0.3\n\n\
+             [loading]\nincrement = 0.002\n\n[loading.compression]\ndisplacement = 0.01\n\n\
+             [loading.control]\n{both}"
+        ),
+        "control.toml",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("loading.increment") && e.contains("steps"), "{e}");
     let flank = both.replace("\"left\"", "\"flank\"");
     let e = plain(&flank).unwrap().model().unwrap_err().to_string();
     assert!(e.contains("loading.control.plus[0].set") && e.contains("flank"), "{e}");
