@@ -19,7 +19,8 @@ use cosdem_fem::element::{ElementKind, QuadratureRule};
 use cosdem_fem::material::{Material, MaterialError, MaterialInput, TrialId};
 use cosdem_fem::mesh::Mesh;
 use cosdem_fem::solve::{
-    Dirichlet, Loading, Model, PathControl, Solver, SolverSettings, StepReport,
+    Dirichlet, Loading, Model, PathControl, SolutionView, Solver, SolverSettings, SolverState,
+    StepControl, StepObserver, StepReport,
 };
 
 const E: f64 = 1e6;
@@ -196,6 +197,65 @@ fn a_combined_control_quantity_follows_the_snap_back_too() {
         tops.push(top);
     }
     assert!(tops.windows(2).any(|w| w[1] < w[0]), "the top turns back: {tops:?}");
+}
+
+/// Stops a run after a given step, keeping the solver's state there (what a checkpoint
+/// saves; the bar's material has no state of its own).
+struct StopAfter {
+    step: u64,
+    saved: Option<SolverState>,
+}
+
+impl StepObserver for StopAfter {
+    fn on_step(&mut self, _: &StepReport, _: &SolutionView<'_>) -> cosdem_fem::Result<()> {
+        Ok(())
+    }
+    fn after_step(
+        &mut self,
+        solver: &Solver,
+        _: &mut dyn Material,
+    ) -> cosdem_fem::Result<StepControl> {
+        if solver.step() < self.step {
+            return Ok(StepControl::Continue);
+        }
+        self.saved = Some(solver.state());
+        Ok(StepControl::Stop)
+    }
+}
+
+/// A controlled run stopped after step 10 (past the peak, before the turn's end) and
+/// restored into a new solver goes on bit for bit as the uninterrupted run: the same load
+/// factors and dofs at every step to the end (the control's progress is part of the state).
+#[test]
+fn a_controlled_run_resumes_bit_for_bit() {
+    let tau_end = 5.0 * E0 * H;
+    let settings = SolverSettings {
+        steps: 24,
+        force_tolerance: 1e-12,
+        max_iterations: 30,
+        ..Default::default()
+    };
+    let (model, mut material) = bar(0.02, Some(tau_end));
+    let (whole, whole_log) = run_controlled(model.clone(), &mut material);
+
+    let mut first = Solver::new(model.clone(), settings.clone()).unwrap();
+    let mut stop = StopAfter { step: 10, saved: None };
+    let err = first.run(&mut material, &mut stop).unwrap_err();
+    assert!(err.to_string().contains("10"), "{err}");
+    let saved = stop.saved.expect("the state after step 10");
+    assert!(saved.progress > 0.4 && saved.progress < 0.42, "{}", saved.progress);
+
+    let mut resumed = Solver::new(model, settings).unwrap();
+    resumed.restore(saved).unwrap();
+    let mut log: Vec<StepReport> = Vec::new();
+    resumed.run(&mut material, &mut log).unwrap();
+    assert_eq!(log.len(), 14);
+    for (a, b) in log.iter().zip(&whole_log[10..]) {
+        assert_eq!(a.load_factor.to_bits(), b.load_factor.to_bits(), "step {}", a.step);
+        assert_eq!(a.time.to_bits(), b.time.to_bits(), "step {}", a.step);
+    }
+    let bits = |s: &Solver| s.solution().dofs.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&resumed), bits(&whole));
 }
 
 /// The same bar pulled by the top's displacement past the turn of the path: there is no
