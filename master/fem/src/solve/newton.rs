@@ -162,9 +162,7 @@ impl Solver {
             let q = self.lambda_rate(&asm.k_fc_du, &u_n);
             match self.controlled_correction(&r0, &q, &u_n, g, *tau, symmetric) {
                 Ok((d, l)) => {
-                    self.add_free(&mut u, &d, 1.0);
-                    (lambda, dl) = (lambda + l, l);
-                    self.set_prescribed(&mut u, lambda);
+                    (lambda, dl) = (self.move_to(&mut u, &d, 1.0, lambda, l), l);
                     d
                 }
                 Err(f) => return Ok(Attempt::Failed(f)),
@@ -214,10 +212,10 @@ impl Solver {
                 let (u_prev, _, l_prev) =
                     previous.as_ref().expect("grows implies a previous iterate");
                 u.clone_from(u_prev);
-                self.add_free(&mut u, &du, alpha);
                 if controlled.is_some() {
-                    lambda = l_prev + alpha * dl;
-                    self.set_prescribed(&mut u, lambda);
+                    lambda = self.move_to(&mut u, &du, alpha, *l_prev, dl);
+                } else {
+                    self.add_free(&mut u, &du, alpha);
                 }
                 tracing::debug!(alpha, "line search");
             };
@@ -337,9 +335,7 @@ impl Solver {
                     Err(f) => return Ok(Attempt::Failed(f)),
                 };
                 previous = Some((u.clone(), rn, lambda));
-                self.add_free(&mut u, &d, 1.0);
-                (lambda, dl) = (lambda + l, l);
-                self.set_prescribed(&mut u, lambda);
+                (lambda, dl) = (self.move_to(&mut u, &d, 1.0, lambda, l), l);
                 du = d;
                 continue;
             }
@@ -407,6 +403,16 @@ impl Solver {
         })?;
         tracing::debug!(dlambda = dl, tau = control.tau(u), tau_target, "path control");
         Ok((a.iter().zip(b).map(|(a, b)| a + dl * b).collect(), dl))
+    }
+
+    /// Path control: moves the iterate by `alpha` times the correction `(du, dlambda)` from
+    /// `(u, lambda)` (the free dofs by `alpha du`, the prescribed ones to their values at the
+    /// new load factor) and returns that load factor.
+    fn move_to(&self, u: &mut [f64], du: &[f64], alpha: f64, lambda: f64, dlambda: f64) -> f64 {
+        self.add_free(u, du, alpha);
+        let lambda = lambda + alpha * dlambda;
+        self.set_prescribed(u, lambda);
+        lambda
     }
 
     /// Sets every prescribed dof of `u` to its value at load factor `lambda`.
