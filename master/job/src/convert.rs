@@ -15,6 +15,7 @@ use cosdem_fem::mesh::{Mesh, MeshDescription};
 use cosdem_fem::solve::{
     Dirichlet, EdgeLoad, EdgeLoadKind, Loading, Platens, Ramp, SolverSettings,
 };
+use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::Arc;
 
@@ -219,20 +220,32 @@ impl Job {
     }
 }
 
+/// `Ok` when `set` names a non-empty set among `sets` (the mesh's node or edge sets, `kind`
+/// `"node"` or `"edge"`); else the error naming `field`, the value and the sets there are.
+pub(crate) fn require_set<T>(
+    field: &'static str,
+    set: &str,
+    kind: &str,
+    sets: &BTreeMap<String, Vec<T>>,
+) -> Result<()> {
+    if sets.get(set).is_some_and(|s| !s.is_empty()) {
+        return Ok(());
+    }
+    Err(Error::InvalidSetting {
+        field,
+        value: set.to_string(),
+        reason: format!(
+            "the mesh has no non-empty {kind} set of that name (known: {})",
+            sets.keys().map(String::as_str).collect::<Vec<_>>().join(", ")
+        ),
+    })
+}
+
 /// A path control's node set must be a non-empty set of the mesh and its value finite and
 /// not zero (`at`: the control's key, `loading.control` or `stage[i].control`).
 pub(crate) fn check_control(at: &str, c: &ControlSection, mesh: &Mesh) -> Result<()> {
     let field = |rest: &str| crate::validate::interned(format!("{at}.{rest}"));
-    if mesh.node_sets.get(&c.set).is_none_or(Vec::is_empty) {
-        return Err(Error::InvalidSetting {
-            field: field("set"),
-            value: c.set.clone(),
-            reason: format!(
-                "the mesh has no non-empty node set of that name (known: {})",
-                mesh.node_sets.keys().cloned().collect::<Vec<_>>().join(", ")
-            ),
-        });
-    }
+    require_set(field("set"), &c.set, "node", &mesh.node_sets)?;
     if !(c.value.is_finite() && c.value != 0.0) {
         return Err(Error::InvalidSetting {
             field: field("value"),
@@ -241,16 +254,7 @@ pub(crate) fn check_control(at: &str, c: &ControlSection, mesh: &Mesh) -> Result
         });
     }
     for (j, t) in c.plus.iter().enumerate() {
-        if mesh.node_sets.get(&t.set).is_none_or(Vec::is_empty) {
-            return Err(Error::InvalidSetting {
-                field: field(&format!("plus[{j}].set")),
-                value: t.set.clone(),
-                reason: format!(
-                    "the mesh has no non-empty node set of that name (known: {})",
-                    mesh.node_sets.keys().cloned().collect::<Vec<_>>().join(", ")
-                ),
-            });
-        }
+        require_set(field(&format!("plus[{j}].set")), &t.set, "node", &mesh.node_sets)?;
         if !t.weight.is_finite() {
             return Err(Error::InvalidSetting {
                 field: field(&format!("plus[{j}].weight")),

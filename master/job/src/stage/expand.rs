@@ -4,6 +4,7 @@
 //! ([`Job::next_stages`], for a caller that gives its stages as it goes).
 
 use super::{MAX_STAGES, SolverStage, StageRamp, StageSection, bad, component, key};
+use crate::convert::require_set;
 use crate::region::body_load;
 use crate::schema::Job;
 use cosdem_fem::assembly::Component;
@@ -345,22 +346,9 @@ impl Job {
 
     /// [`Job::check_stage_sets`] of stage `i`, `s`.
     fn check_sets_of_stage(&self, i: usize, s: &StageSection, mesh: &Mesh) -> Result<()> {
-        let unknown = |field: &'static str, set: &str, kind: &str, known: Vec<&String>| {
-            let known: Vec<&str> = known.into_iter().map(String::as_str).collect();
-            bad(
-                field,
-                set,
-                format!(
-                    "the mesh has no non-empty {kind} set of that name (known: {})",
-                    known.join(", ")
-                ),
-            )
-        };
         for (j, p) in s.prescribed.iter().enumerate() {
-            if mesh.node_sets.get(&p.set).is_none_or(Vec::is_empty) {
-                let at = key(i, &format!(".prescribed[{j}].set"));
-                return Err(unknown(at, &p.set, "node", mesh.node_sets.keys().collect()));
-            }
+            let at = key(i, &format!(".prescribed[{j}].set"));
+            require_set(at, &p.set, "node", &mesh.node_sets)?;
         }
         let edges = s
             .pressure
@@ -371,9 +359,7 @@ impl Job {
                 s.traction.iter().enumerate().map(|(j, t)| (format!(".traction[{j}].set"), &t.set)),
             );
         for (at, set) in edges {
-            if mesh.edge_sets.get(set).is_none_or(Vec::is_empty) {
-                return Err(unknown(key(i, &at), set, "edge", mesh.edge_sets.keys().collect()));
-            }
+            require_set(key(i, &at), set, "edge", &mesh.edge_sets)?;
         }
         if let Some(c) = &s.control {
             crate::convert::check_control(&format!("stage[{i}].control"), c, mesh)?;
