@@ -115,15 +115,14 @@ fn bar(top_uy: f64, control: Option<f64>) -> (Model, Bar) {
     (model, Bar { weak })
 }
 
-/// Runs a controlled bar in 24 steps, solved to a relative residual of 1e-12.
+/// The controlled bar's settings: 24 steps, solved to a relative residual of 1e-12.
+fn controlled_settings() -> SolverSettings {
+    SolverSettings { steps: 24, force_tolerance: 1e-12, max_iterations: 30, ..Default::default() }
+}
+
+/// Runs a controlled bar with [`controlled_settings`].
 fn run_controlled(model: Model, material: &mut Bar) -> (Solver, Vec<StepReport>) {
-    let settings = SolverSettings {
-        steps: 24,
-        force_tolerance: 1e-12,
-        max_iterations: 30,
-        ..Default::default()
-    };
-    let mut solver = Solver::new(model, settings).unwrap();
+    let mut solver = Solver::new(model, controlled_settings()).unwrap();
     let mut log: Vec<StepReport> = Vec::new();
     solver.run(material, &mut log).unwrap();
     (solver, log)
@@ -229,12 +228,7 @@ impl StepObserver for StopAfter {
 #[test]
 fn a_controlled_run_resumes_bit_for_bit() {
     let tau_end = 5.0 * E0 * H;
-    let settings = SolverSettings {
-        steps: 24,
-        force_tolerance: 1e-12,
-        max_iterations: 30,
-        ..Default::default()
-    };
+    let settings = controlled_settings();
     let (model, mut material) = bar(0.02, Some(tau_end));
     let (whole, whole_log) = run_controlled(model.clone(), &mut material);
 
