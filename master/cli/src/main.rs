@@ -38,6 +38,7 @@ mod tradeoff;
 use anyhow::Result;
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
+use std::process::ExitCode;
 
 #[derive(Parser)]
 #[command(name = "cosdem", version, about = "Two-scale FEM x DEM for granular materials")]
@@ -77,14 +78,15 @@ fn stem(job: &Path) -> String {
     job.file_stem().map_or("run".into(), |s| s.to_string_lossy().into_owned())
 }
 
-fn main() -> Result<()> {
+fn main() -> Result<ExitCode> {
     let cli = Cli::parse();
     match cli.command {
-        Command::Run(args) => run::run(args),
+        Command::Run(args) => return run::run(args),
         Command::Rve(args) => rve::rve(args),
         Command::Study { what } => study::study(what),
         Command::Plot { run_dir } => plot::plot(&run_dir),
         Command::Export(args) => export::export(args),
         Command::Bench { what } => bench::bench(what),
-    }
+    }?;
+    Ok(ExitCode::SUCCESS)
 }

@@ -15,6 +15,7 @@ use cosdem_pool::PoolConfig;
 use cosdem_worker::Token;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::path::{Path, PathBuf};
+use std::process::ExitCode;
 use std::time::Instant;
 
 #[derive(clap::Args)]
@@ -197,7 +198,10 @@ fn worker_choice(job: &Job, args: &RunArgs) -> Result<WorkerChoice> {
     Ok(WorkerChoice { addresses, config })
 }
 
-pub(crate) fn run(args: RunArgs) -> Result<()> {
+/// Runs the job; a run stopped by Ctrl-C or SIGTERM is a deliberate stop, not an error: its
+/// message goes to standard error as a plain line (no error chain or backtrace) and the exit
+/// code is 1.
+pub(crate) fn run(args: RunArgs) -> Result<ExitCode> {
     let job = Job::load(&args.job)?;
     let dir = run_dir(&args, &job);
     let workers = worker_choice(&job, &args)?;
@@ -253,18 +257,21 @@ pub(crate) fn run(args: RunArgs) -> Result<()> {
         );
     }
     match outcome.ending {
-        Ending::Finished => Ok(()),
-        Ending::Interrupted => anyhow::bail!(
-            "interrupted after step {}: the finished steps and the checkpoint are in {}; continue with `{resume_command}`",
-            s.steps,
-            dir.display(),
-        ),
+        Ending::Finished => Ok(ExitCode::SUCCESS),
+        Ending::Interrupted => {
+            eprintln!(
+                "interrupted after step {}: the finished steps and the checkpoint are in {}; continue with `{resume_command}`",
+                s.steps,
+                dir.display(),
+            );
+            Ok(ExitCode::FAILURE)
+        }
         Ending::Stopped => {
             println!(
                 "stopped after step {} (--max-steps); continue with `{resume_command}`",
                 s.steps
             );
-            Ok(())
+            Ok(ExitCode::SUCCESS)
         }
         Ending::Failed(e) => {
             Err(e).with_context(|| format!("run stopped; finished steps are in {}", dir.display()))
