@@ -158,6 +158,35 @@ fn bench_dem(quick: bool) -> Result<()> {
         fit(|r| r.steps as f64),
         runs.len()
     );
+    // Issue 30, item 1's candidates on the same specimens and path, each at the default
+    // criterion and tolerance: cost per solve, its exponent, and the times at the smallest and
+    // largest size.
+    for c in cosdem_dem::bench::Candidate::all() {
+        let runs = cosdem_dem::bench::relaxation_scaling_with(sides, &c)?;
+        let fit = |f: fn(&cosdem_dem::bench::Relaxation) -> f64| {
+            let pts: Vec<(f64, f64)> = runs.iter().map(|r| (r.discs as f64, f(r))).collect();
+            cosdem_dem::bench::power_law_exponent(&pts)
+        };
+        let per = |r: &cosdem_dem::bench::Relaxation| {
+            format!(
+                "{} discs {:.0} steps {:.2} ms",
+                r.discs,
+                r.steps as f64 / r.count as f64,
+                1e3 * r.seconds / r.count as f64
+            )
+        };
+        let (first, last) = (&runs[0], &runs[runs.len() - 1]);
+        println!(
+            "candidate {}: cost ~ N^{:.2}, steps ~ N^{:.2}; per solve {} .. {}; {} of {} solves converged",
+            c.name,
+            fit(|r| r.seconds),
+            fit(|r| r.steps as f64),
+            per(first),
+            per(last),
+            runs.iter().map(|r| r.converged).sum::<usize>(),
+            runs.iter().map(|r| r.count).sum::<usize>(),
+        );
+    }
     let (n, steps, conv, wall) = cosdem_dem::bench::relaxation()?;
     println!(
         "relaxation 0.0784 m^2 ({n} discs, e_yy = -1e-3): {steps} steps, converged {conv}, {wall:.3} s"

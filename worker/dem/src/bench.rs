@@ -4,7 +4,7 @@
 use crate::assembly::Assembly;
 use crate::error::Result;
 use crate::integrate::StageTimes;
-use crate::spec::{AssemblySpec, ContactParams, PackingSpec};
+use crate::spec::{AssemblySpec, ContactParams, Driver, PackingSpec, RelaxationSpec};
 use cosdem_common::MacroDeformation;
 use std::time::Instant;
 
@@ -155,6 +155,67 @@ pub struct Relaxation {
 /// Load steps of [`relaxation_scaling`].
 pub const SCALING_STEPS: usize = 10;
 
+/// A way of relaxing the yardstick's load steps (issue 30, item 1's candidates): the
+/// relaxation settings, whether each trial starts from the last trial (`warm_start`), and
+/// the trial solves per load step (`iterates`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Candidate {
+    /// The name the benchmark prints.
+    pub name: &'static str,
+    /// Driver, criterion and tolerance.
+    pub relaxation: RelaxationSpec,
+    /// Each trial from the last one (the job's `warm_start`) instead of the committed state.
+    pub warm_start: bool,
+    /// Trial solves per load step, as a Newton iteration asks them: at the fractions
+    /// `1 - 10^-j` of the step's increment (j = 1 .. iterates - 1), then at the step's end,
+    /// which is committed. 1: one solve per step.
+    pub iterates: usize,
+}
+
+impl Candidate {
+    /// The default relaxation, one solve per step: the yardstick's own path.
+    pub fn reference() -> Self {
+        Self {
+            name: "default (Cundall 0.7), one solve per step",
+            relaxation: RelaxationSpec::default(),
+            warm_start: false,
+            iterates: 1,
+        }
+    }
+
+    /// The candidates the benchmark compares, each at the default criterion and tolerance:
+    /// the drivers (Cundall's damping at 0.7 and 0.9, FIRE) on one solve per step, and the
+    /// initial guess (from the committed state or, warm, from the last trial) on three
+    /// Newton-like trials per step.
+    pub fn all() -> Vec<Self> {
+        let cundall = |alpha| RelaxationSpec {
+            driver: Driver::Cundall { alpha },
+            ..RelaxationSpec::default()
+        };
+        let three = |name, warm_start| Self {
+            name,
+            relaxation: RelaxationSpec::default(),
+            warm_start,
+            iterates: 3,
+        };
+        vec![
+            Self::reference(),
+            Self {
+                name: "Cundall 0.9, one solve per step",
+                relaxation: cundall(0.9),
+                ..Self::reference()
+            },
+            Self {
+                name: "FIRE, one solve per step",
+                relaxation: RelaxationSpec { driver: Driver::fire(), ..RelaxationSpec::default() },
+                ..Self::reference()
+            },
+            three("default, 3 trials per step, each from the committed state", false),
+            three("warm start, 3 trials per step, each from the last trial", true),
+        ]
+    }
+}
+
 /// The cost of a relaxation against the assembly's size: the biaxial example's specimen
 /// (random discs of radii 2-3 mm, seed 7, brought to 100 kPa, periodic cell, the default
 /// relaxation) at each side in `sides`, taken through [`SCALING_STEPS`] load steps as a Gauss
@@ -162,6 +223,14 @@ pub const SCALING_STEPS: usize = 10;
 /// solved from the last committed state, then committed: to 1 % axial strain). Issue 30's
 /// measure of "DEM steps per answer" against N.
 pub fn relaxation_scaling(sides: &[f64]) -> Result<Vec<Relaxation>> {
+    relaxation_scaling_with(sides, &Candidate::reference())
+}
+
+/// [`relaxation_scaling`] relaxed by `candidate` (a random specimen is generated with the
+/// default relaxation whatever the job's, so every candidate starts from the same packing). `count` is the number of
+/// solves, `SCALING_STEPS * iterates`.
+pub fn relaxation_scaling_with(sides: &[f64], candidate: &Candidate) -> Result<Vec<Relaxation>> {
+    let iterates = candidate.iterates.max(1);
     let mut out = Vec::with_capacity(sides.len());
     for &side in sides {
         let spec = AssemblySpec {
@@ -174,25 +243,32 @@ pub fn relaxation_scaling(sides: &[f64]) -> Result<Vec<Relaxation>> {
                 confining_stress: 1e5,
             },
             boundary: crate::spec::BoundarySpec::Periodic,
+            relaxation: candidate.relaxation.clone(),
+            warm_start: candidate.warm_start,
             ..Default::default()
         };
         let mut a = Assembly::new(&spec)?;
         let mut run = Relaxation {
             discs: a.disc_count(),
-            count: SCALING_STEPS,
+            count: SCALING_STEPS * iterates,
             steps: 0,
             converged: 0,
             seconds: 0.0,
         };
+        let at = |e: f64| {
+            MacroDeformation::from_gradient([[4e-4 * e, 0.0], [0.0, -1e-3 * e]], 0.0, [0.0; 2])
+        };
         for k in 1..=SCALING_STEPS {
-            let e = k as f64;
-            let target =
-                MacroDeformation::from_gradient([[4e-4 * e, 0.0], [0.0, -1e-3 * e]], 0.0, [0.0; 2]);
-            let t0 = Instant::now();
-            let r = a.solve(&target)?;
-            run.seconds += t0.elapsed().as_secs_f64();
-            run.steps += r.diagnostics.steps;
-            run.converged += usize::from(r.diagnostics.converged);
+            for j in 1..=iterates {
+                // 0.9, 0.99, ... of the step's increment, then its end.
+                let short = if j == iterates { 0.0 } else { 10f64.powi(-(j as i32)) };
+                let target = at(k as f64 - short);
+                let t0 = Instant::now();
+                let r = a.solve(&target)?;
+                run.seconds += t0.elapsed().as_secs_f64();
+                run.steps += r.diagnostics.steps;
+                run.converged += usize::from(r.diagnostics.converged);
+            }
             a.commit();
         }
         out.push(run);
@@ -246,5 +322,30 @@ mod tests {
                 .collect();
             assert!((power_law_exponent(&pts) - b).abs() < 1e-12, "{b}");
         }
+    }
+
+    /// The candidates on the smallest specimen (106 discs): each starts from the same packing
+    /// and every relaxation converges; the reference candidate is the yardstick's path; and a
+    /// warm start saves steps on the Newton-like trials (the later trials are 1 % and 0 % of
+    /// the increment away from the last one, so a start from it is far closer to equilibrium
+    /// than the committed state: at least a third fewer steps, a bound it passes by a wide
+    /// margin and that a warm start ignored by the solve would fail).
+    #[test]
+    fn candidates_start_alike_converge_and_warm_trials_save_steps() {
+        let runs: Vec<Relaxation> = Candidate::all()
+            .iter()
+            .map(|c| relaxation_scaling_with(&[0.05], c).unwrap().remove(0))
+            .collect();
+        for (c, r) in Candidate::all().iter().zip(&runs) {
+            assert_eq!(r.discs, runs[0].discs, "{}", c.name);
+            assert_eq!(r.count, SCALING_STEPS * c.iterates, "{}", c.name);
+            assert_eq!(r.converged, r.count, "{}", c.name);
+        }
+        assert_eq!(relaxation_scaling(&[0.05]).unwrap()[0].steps, runs[0].steps);
+        let by = |name: &str| {
+            let i = Candidate::all().iter().position(|c| c.name.starts_with(name)).unwrap();
+            runs[i].steps as f64
+        };
+        assert!(by("warm start") < by("default, 3 trials") * 2.0 / 3.0, "{runs:?}");
     }
 }
