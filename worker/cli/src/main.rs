@@ -136,8 +136,15 @@ fn bench_dem(quick: bool) -> Result<()> {
     // DEM steps per answer against the assembly's size (issue 30, item 1): the biaxial
     // example's specimen at sides 0.05-0.4 m (about 100-6 700 discs).
     let sides: &[f64] = if quick { &[0.05, 0.1] } else { &[0.05, 0.1, 0.2, 0.4] };
-    let runs = cosdem_dem::bench::relaxation_scaling(sides)?;
-    for r in &runs {
+    // Issue 30, item 1's candidates on the same specimens and path, each at the default
+    // criterion and tolerance; the first is the default relaxation, the yardstick itself.
+    let candidates = cosdem_dem::bench::Candidate::all();
+    let mut measured = Vec::with_capacity(candidates.len());
+    for c in &candidates {
+        measured.push(cosdem_dem::bench::relaxation_scaling_with(sides, c)?);
+    }
+    let runs = &measured[0];
+    for r in runs {
         println!(
             "biaxial load steps to 1 % ({} discs, random 2-3 mm, periodic, 100 kPa): {} \
              relaxations, {} converged, {:.0} steps and {:.2} ms per relaxation",
@@ -148,25 +155,15 @@ fn bench_dem(quick: bool) -> Result<()> {
             1e3 * r.seconds / r.count as f64
         );
     }
-    let fit = |f: fn(&cosdem_dem::bench::Relaxation) -> f64| {
-        let pts: Vec<(f64, f64)> = runs.iter().map(|r| (r.discs as f64, f(r))).collect();
-        cosdem_dem::bench::power_law_exponent(&pts)
-    };
     println!(
         "relaxation cost ~ N^{:.2}, steps ~ N^{:.2} (least squares over {} sizes)",
-        fit(|r| r.seconds),
-        fit(|r| r.steps as f64),
+        exponent(runs, |r| r.seconds),
+        exponent(runs, |r| r.steps as f64),
         runs.len()
     );
-    // Issue 30, item 1's candidates on the same specimens and path, each at the default
-    // criterion and tolerance: cost per solve, its exponent, and the times at the smallest and
-    // largest size.
-    for c in cosdem_dem::bench::Candidate::all() {
-        let runs = cosdem_dem::bench::relaxation_scaling_with(sides, &c)?;
-        let fit = |f: fn(&cosdem_dem::bench::Relaxation) -> f64| {
-            let pts: Vec<(f64, f64)> = runs.iter().map(|r| (r.discs as f64, f(r))).collect();
-            cosdem_dem::bench::power_law_exponent(&pts)
-        };
+    // Each candidate: cost per solve, its exponent, and the times at the smallest and largest
+    // size.
+    for (c, runs) in candidates.iter().zip(&measured) {
         let per = |r: &cosdem_dem::bench::Relaxation| {
             format!(
                 "{} discs {:.0} steps {:.2} ms",
@@ -179,8 +176,8 @@ fn bench_dem(quick: bool) -> Result<()> {
         println!(
             "candidate {}: cost ~ N^{:.2}, steps ~ N^{:.2}; per solve {} .. {}; {} of {} solves converged",
             c.name,
-            fit(|r| r.seconds),
-            fit(|r| r.steps as f64),
+            exponent(runs, |r| r.seconds),
+            exponent(runs, |r| r.steps as f64),
             per(first),
             per(last),
             runs.iter().map(|r| r.converged).sum::<usize>(),
@@ -196,6 +193,15 @@ fn bench_dem(quick: bool) -> Result<()> {
         println!("random packing 0.0784 m^2 ({n} discs, {boundary:?}): built in {wall:.3} s");
     }
     Ok(())
+}
+
+/// The least-squares exponent of `f` against the disc count over `runs`.
+fn exponent(
+    runs: &[cosdem_dem::bench::Relaxation],
+    f: fn(&cosdem_dem::bench::Relaxation) -> f64,
+) -> f64 {
+    let pts: Vec<(f64, f64)> = runs.iter().map(|r| (r.discs as f64, f(r))).collect();
+    cosdem_dem::bench::power_law_exponent(&pts)
 }
 
 fn listen(args: ListenArgs) -> Result<()> {

@@ -227,8 +227,8 @@ pub fn relaxation_scaling(sides: &[f64]) -> Result<Vec<Relaxation>> {
 }
 
 /// [`relaxation_scaling`] relaxed by `candidate` (a random specimen is generated with the
-/// default relaxation whatever the job's, so every candidate starts from the same packing). `count` is the number of
-/// solves, `SCALING_STEPS * iterates`.
+/// default relaxation whatever the job's, so every candidate starts from the same packing).
+/// `count` is the number of solves, `SCALING_STEPS * iterates`.
 pub fn relaxation_scaling_with(sides: &[f64], candidate: &Candidate) -> Result<Vec<Relaxation>> {
     let iterates = candidate.iterates.max(1);
     let mut out = Vec::with_capacity(sides.len());
