@@ -25,8 +25,10 @@ pub use text::printable;
 /// assembly spec has `relaxation.substep` (a worker of protocol 2 refuses the spec with an
 /// unknown field; the handshake says so first, naming both versions). 4: the diagnostics of
 /// every answer carry the micro descriptors (porosity, coordination, fabric, sliding, mean
-/// rotation; a master of protocol 3 would drop them without a word, so it is refused).
-pub const PROTOCOL_VERSION: u32 = 4;
+/// rotation; a master of protocol 3 would drop them without a word, so it is refused). 5: the
+/// assembly spec may have `relaxation.predictor`, and the state of an `extrapolated` assembly
+/// carries its last step's increment (a worker of protocol 4 refuses the spec by name).
+pub const PROTOCOL_VERSION: u32 = 5;
 
 /// Default limit on one gRPC message, both directions (256 MiB): large assemblies'
 /// exported states and snapshots must pass.

@@ -66,9 +66,10 @@ fn absent_descriptors_stay_absent() {
     assert_eq!(through_the_wire(&response(None)).diagnostics.descriptors, None);
 }
 
-/// Protocol 4 is the one that carries the descriptors: a master or worker of protocol 3
-/// would drop them, so the handshake must tell the two apart.
+/// Protocol 4 is the first that carries the descriptors (a master or worker of protocol 3
+/// would drop them), 5 the first whose assembly spec may name a predictor: the handshake must
+/// tell each from the one before.
 #[test]
-fn protocol_version_is_four() {
-    assert_eq!(PROTOCOL_VERSION, 4);
+fn protocol_version_is_five() {
+    assert_eq!(PROTOCOL_VERSION, 5);
 }

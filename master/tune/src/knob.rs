@@ -6,7 +6,7 @@
 
 use crate::table::TableError;
 use cosdem_dem::AssemblySpec;
-use cosdem_dem::spec::{Driver, TangentKind};
+use cosdem_dem::spec::{Driver, Predictor, TangentKind};
 use cosdem_job::{Job, MaterialSection};
 
 /// One setting of the sweep: a label and the job it produces.
@@ -104,13 +104,16 @@ pub enum Knob {
     RelaxationElasticShortcut,
     /// `relaxation.substep`: the largest affine jump of one relaxation.
     RelaxationSubstep,
+    /// `relaxation.predictor`: the affine jump alone, or with the last step's non-affine
+    /// increment extrapolated.
+    RelaxationPredictor,
     /// `assembly.side`: the assembly's side (m), so its size V.
     AssemblySide,
 }
 
 impl Knob {
     /// Every speed knob, in the order a sweep moves them (so the order of a table's rows).
-    pub const ALL: [Knob; 13] = [
+    pub const ALL: [Knob; 14] = [
         Knob::LoadStep,
         Knob::NewtonSecantUpdates,
         Knob::NewtonStallIterations,
@@ -123,6 +126,7 @@ impl Knob {
         Knob::RelaxationSkipBelow,
         Knob::RelaxationElasticShortcut,
         Knob::RelaxationSubstep,
+        Knob::RelaxationPredictor,
         Knob::AssemblySide,
     ];
 
@@ -157,6 +161,7 @@ impl Knob {
             Knob::RelaxationSkipBelow => "relaxation.skip_below",
             Knob::RelaxationElasticShortcut => "relaxation.elastic_shortcut",
             Knob::RelaxationSubstep => "relaxation.substep",
+            Knob::RelaxationPredictor => "relaxation.predictor",
             Knob::AssemblySide => "assembly.side",
         }
     }
@@ -169,8 +174,8 @@ impl Knob {
 
     /// True for the knobs an accuracy target sets (to a measured setting or to the table's
     /// default value). Not: `relaxation.substep` (it trades the other way, cost for a more
-    /// accurate micro path), Newton's `secant_updates` and `stall_iterations` (no committed
-    /// table has a row of them), and the assembly side (the user's physical choice: a smaller
+    /// accurate micro path), Newton's `secant_updates` and `stall_iterations` and
+    /// `relaxation.predictor` (no committed table has a row of them), and the assembly side (the user's physical choice: a smaller
     /// assembly shifts every property).
     pub const fn planned(self) -> bool {
         matches!(
@@ -240,6 +245,7 @@ impl Knob {
             Knob::RelaxationSkipBelow => format!("{:e}", a.relaxation.skip_below),
             Knob::RelaxationElasticShortcut => a.relaxation.elastic_shortcut.to_string(),
             Knob::RelaxationSubstep => format!("{:e}", a.relaxation.substep),
+            Knob::RelaxationPredictor => predictor_name(a.relaxation.predictor).into(),
             Knob::AssemblySide => match a.packing.side() {
                 Some(side) => format!("{side} m"),
                 None => format!("given ({} packing)", a.packing.kind()),
@@ -256,6 +262,7 @@ impl Knob {
     /// numbers), `relaxation.driver` `fire`/`cundall`, `tangent`
     /// `paper`/`sliding_aware`/`secant`/`perturbation` (strain 1e-5), `warm_start`,
     /// `relaxation.elastic_shortcut` and `newton.secant_updates` `true`/`false`,
+    /// `relaxation.predictor` `affine`/`extrapolated`,
     /// `newton.stall_iterations` (a count, 0 = off), `assembly.side` (m). The moves of
     /// [`Knob::moves`] are these (a test checks they agree). A job without a DEM material has
     /// only the load step and Newton's knobs.
@@ -309,6 +316,12 @@ impl Knob {
             Knob::RelaxationSkipBelow => a.relaxation.skip_below = number().ok_or_else(unknown)?,
             Knob::RelaxationElasticShortcut => a.relaxation.elastic_shortcut = flag()?,
             Knob::RelaxationSubstep => a.relaxation.substep = number().ok_or_else(unknown)?,
+            Knob::RelaxationPredictor => {
+                a.relaxation.predictor = [Predictor::Affine, Predictor::Extrapolated]
+                    .into_iter()
+                    .find(|p| predictor_name(*p) == setting)
+                    .ok_or_else(unknown)?;
+            }
             Knob::AssemblySide => {
                 let s = number().ok_or_else(unknown)?;
                 *a.packing.side_mut().ok_or_else(unknown)? = s;
@@ -340,6 +353,7 @@ impl Knob {
                 a.relaxation.elastic_shortcut = to.relaxation.elastic_shortcut;
             }
             Knob::RelaxationSubstep => a.relaxation.substep = to.relaxation.substep,
+            Knob::RelaxationPredictor => a.relaxation.predictor = to.relaxation.predictor,
             Knob::AssemblySide => {
                 if let (Some(s), Some(side)) = (to.packing.side(), a.packing.side_mut()) {
                     *side = s;
@@ -411,6 +425,10 @@ impl Knob {
             {
                 vec![format!("{SUBSTEP:e}")]
             }
+            // The initial guess of issue 30, item 1 (docs/notes/2026-12-08-extrapolated-predictor.md).
+            Knob::RelaxationPredictor if a.relaxation.predictor == Predictor::Affine => {
+                vec![predictor_name(Predictor::Extrapolated).into()]
+            }
             Knob::AssemblySide => return side_moves(base, a),
             _ => Vec::new(),
         };
@@ -429,6 +447,14 @@ impl std::str::FromStr for Knob {
 
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         Knob::from_name(s).ok_or_else(|| TableError::UnknownKnob { knob: s.to_string() })
+    }
+}
+
+/// The job file's name of a predictor (`affine`, `extrapolated`).
+fn predictor_name(p: Predictor) -> &'static str {
+    match p {
+        Predictor::Affine => "affine",
+        Predictor::Extrapolated => "extrapolated",
     }
 }
 
@@ -474,7 +500,7 @@ fn with(base: &Job, knob: &'static str, setting: &str, f: impl Fn(&mut Job)) -> 
 }
 
 /// The reference: the job's scene with tight settings (relaxation tolerance 1e-5, time-step
-/// safety 0.25, no mass scaling, Cundall damping, half the load step, cold starts, no
+/// safety 0.25, no mass scaling, Cundall damping, half the load step, cold affine starts, no
 /// skipped or linear answers, no Newton secant updates, the job's substeps) and the
 /// job's tangent (the paper's for a sliding-aware one): a job past a peak needs the
 /// perturbation or adaptive tangent to converge at all (the paper tangent stays elastic while
@@ -503,6 +529,7 @@ pub fn reference(base: &Job) -> Variant {
                 a.tangent = TangentKind::Paper;
             }
             a.warm_start = false;
+            a.relaxation.predictor = Predictor::Affine;
             // Every Gauss point relaxed at every evaluation.
             a.relaxation.skip_below = 0.0;
             a.relaxation.elastic_shortcut = false;

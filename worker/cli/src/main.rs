@@ -50,6 +50,11 @@ enum BenchWhat {
         /// Fewer steps (a smoke run).
         #[arg(long)]
         quick: bool,
+        /// Only the relaxation yardstick, with the candidates whose names contain one of these
+        /// words (comma separated, e.g. `extrapolated,warm`); the default relaxation always
+        /// runs first. The kernel's rates are skipped.
+        #[arg(long, value_delimiter = ',')]
+        candidates: Vec<String>,
     },
 }
 
@@ -58,7 +63,13 @@ fn main() -> Result<()> {
     match cli.command {
         Command::Listen(args) => listen(args),
         Command::Health { addr, timeout } => health(&addr, timeout),
-        Command::Bench { what: BenchWhat::Dem { quick } } => bench_dem(quick),
+        Command::Bench { what: BenchWhat::Dem { quick, candidates } } => {
+            if candidates.is_empty() {
+                bench_dem(quick)
+            } else {
+                bench_relaxation(quick, &candidates)
+            }
+        }
     }
 }
 
@@ -133,12 +144,31 @@ fn bench_dem(quick: bool) -> Result<()> {
         let r = cosdem_dem::bench::rate_with(n, steps, law)?;
         println!("{:>6} discs {name}: {:.3e} particle-steps/s", r.discs, r.rate);
     }
-    // DEM steps per answer against the assembly's size (issue 30, item 1): the biaxial
-    // example's specimen at sides 0.05-0.4 m (about 100-6 700 discs).
+    bench_relaxation(quick, &[])?;
+    let (n, steps, conv, wall) = cosdem_dem::bench::relaxation()?;
+    println!(
+        "relaxation 0.0784 m^2 ({n} discs, e_yy = -1e-3): {steps} steps, converged {conv}, {wall:.3} s"
+    );
+    for boundary in [BoundarySpec::default(), BoundarySpec::Periodic] {
+        let (n, wall) = cosdem_dem::bench::random_build(0.28, boundary.clone())?;
+        println!("random packing 0.0784 m^2 ({n} discs, {boundary:?}): built in {wall:.3} s");
+    }
+    Ok(())
+}
+
+/// DEM steps per answer against the assembly's size (issue 30, item 1): the biaxial example's
+/// specimen at sides 0.05-0.4 m (about 100-6 700 discs), relaxed by each candidate (all of
+/// them, or the default and those whose names contain one of `only`).
+fn bench_relaxation(quick: bool, only: &[String]) -> Result<()> {
     let sides: &[f64] = if quick { &[0.05, 0.1] } else { &[0.05, 0.1, 0.2, 0.4] };
     // Issue 30, item 1's candidates on the same specimens and path, each at the default
     // criterion and tolerance; the first is the default relaxation, the yardstick itself.
-    let candidates = cosdem_dem::bench::Candidate::all();
+    let candidates: Vec<_> = cosdem_dem::bench::Candidate::all()
+        .into_iter()
+        .enumerate()
+        .filter(|(i, c)| *i == 0 || only.is_empty() || only.iter().any(|w| c.name.contains(w)))
+        .map(|(_, c)| c)
+        .collect();
     let mut measured = Vec::with_capacity(candidates.len());
     for c in &candidates {
         measured.push(cosdem_dem::bench::relaxation_scaling_with(sides, c)?);
@@ -183,14 +213,6 @@ fn bench_dem(quick: bool) -> Result<()> {
             runs.iter().map(|r| r.converged).sum::<usize>(),
             runs.iter().map(|r| r.count).sum::<usize>(),
         );
-    }
-    let (n, steps, conv, wall) = cosdem_dem::bench::relaxation()?;
-    println!(
-        "relaxation 0.0784 m^2 ({n} discs, e_yy = -1e-3): {steps} steps, converged {conv}, {wall:.3} s"
-    );
-    for boundary in [BoundarySpec::default(), BoundarySpec::Periodic] {
-        let (n, wall) = cosdem_dem::bench::random_build(0.28, boundary.clone())?;
-        println!("random packing 0.0784 m^2 ({n} discs, {boundary:?}): built in {wall:.3} s");
     }
     Ok(())
 }

@@ -32,6 +32,24 @@ fn a_bad_listen_address_is_refused_by_name() {
     assert!(text.contains("nowhere") && text.contains("--listen"), "{text}");
 }
 
+/// `bench dem --candidates` runs the relaxation yardstick alone: the default relaxation first,
+/// then only the named candidates (a smoke run at the two smallest sizes), and no kernel rate.
+#[test]
+fn bench_dem_runs_the_named_candidates_only() {
+    let out = worker()
+        .args(["bench", "dem", "--quick", "--candidates", "extrapolated predictor"])
+        .output()
+        .expect("runs");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{text}{}", String::from_utf8_lossy(&out.stderr));
+    let candidates: Vec<&str> = text.lines().filter(|l| l.starts_with("candidate ")).collect();
+    assert_eq!(candidates.len(), 2, "{text}");
+    assert!(candidates[0].starts_with("candidate default (Cundall 0.7)"), "{text}");
+    assert!(candidates[1].starts_with("candidate extrapolated predictor, one"), "{text}");
+    assert!(candidates.iter().all(|l| l.contains("20 of 20 solves converged")), "{text}");
+    assert!(!text.contains("particle-steps/s"), "{text}");
+}
+
 /// Kills the worker when the test ends, passed or not.
 struct Running(Child);
 

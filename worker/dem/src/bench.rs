@@ -4,7 +4,7 @@
 use crate::assembly::Assembly;
 use crate::error::Result;
 use crate::integrate::StageTimes;
-use crate::spec::{AssemblySpec, ContactParams, Driver, PackingSpec, RelaxationSpec};
+use crate::spec::{AssemblySpec, ContactParams, Driver, PackingSpec, Predictor, RelaxationSpec};
 use cosdem_common::MacroDeformation;
 use std::time::Instant;
 
@@ -192,6 +192,8 @@ impl Candidate {
             driver: Driver::Cundall { alpha },
             ..RelaxationSpec::default()
         };
+        let extrapolated =
+            RelaxationSpec { predictor: Predictor::Extrapolated, ..RelaxationSpec::default() };
         let three = |name, warm_start| Self {
             name,
             relaxation: RelaxationSpec::default(),
@@ -212,6 +214,16 @@ impl Candidate {
             },
             three("default, 3 trials per step, each from the committed state", false),
             three("warm start, 3 trials per step, each from the last trial", true),
+            Self {
+                name: "extrapolated predictor, one solve per step",
+                relaxation: extrapolated.clone(),
+                ..Self::reference()
+            },
+            Self {
+                name: "extrapolated + warm start, 3 trials per step",
+                relaxation: extrapolated,
+                ..three("", true)
+            },
         ]
     }
 }

@@ -44,7 +44,7 @@ pub mod packing;
 /// The serde specification of an assembly.
 pub mod spec;
 
-pub use assembly::{Assembly, ContactForce, Snapshot, State};
+pub use assembly::{Assembly, ContactForce, Snapshot, State, StepIncrement};
 pub use error::{Error, Result};
 pub use spec::{
     AssemblySpec, BoundarySpec, ContactParams, Criterion, Driver, NormalModel, PackingSpec,

@@ -2,6 +2,7 @@
 
 mod common;
 use common::*;
+use cosdem_dem::spec::Predictor;
 use cosdem_dem::{
     Assembly, AssemblySpec, BoundarySpec, Driver, PackingSpec, TangentKind, TangentialModel,
 };
@@ -65,12 +66,13 @@ type Knob = fn(&mut AssemblySpec);
 fn the_specimen_does_not_depend_on_the_speed_knobs() {
     let base = spec(7, BoundarySpec::Periodic);
     let reference = Assembly::new(&base).unwrap();
-    let knobs: [(&str, Knob); 6] = [
+    let knobs: [(&str, Knob); 7] = [
         ("safety", |s| s.relaxation.safety = 0.25),
         ("tolerance", |s| s.relaxation.tolerance = 1e-5),
         ("driver", |s| s.relaxation.driver = Driver::fire()),
         ("density_scale", |s| s.relaxation.density_scale = 4.0),
         ("warm_start", |s| s.warm_start = true),
+        ("predictor", |s| s.relaxation.predictor = Predictor::Extrapolated),
         ("tangent", |s| s.tangent = TangentKind::Perturbation { strain: 1e-5 }),
     ];
     for (name, change) in knobs {

@@ -95,6 +95,9 @@ fn respec(mut a: Assembly, spec: &AssemblySpec) -> Result<Assembly> {
     a.refc.inv_i = inv_i;
     a.dt = dt;
     a.spec = spec.clone();
+    if spec.relaxation.predictor != crate::spec::Predictor::Extrapolated {
+        a.last_step = None;
+    }
     Ok(a)
 }
 
@@ -177,6 +180,7 @@ pub(super) fn from_packing(spec: &AssemblySpec, law: Law, p: Packing) -> Result<
             relaxed: None,
         },
         trial: None,
+        last_step: None,
         work: Work::default(),
     };
     let dom = a.domain(&MacroDeformation::IDENTITY);
@@ -203,6 +207,7 @@ fn random_assembly(spec: &AssemblySpec, law: Law) -> Result<Assembly> {
     s1.warm_start = false;
     s1.relaxation.tolerance = 1e-3;
     s1.relaxation.max_steps = 4_000;
+    s1.relaxation.predictor = crate::spec::Predictor::Affine;
     // FIRE relaxes the frictionless compression stages several times faster than Cundall.
     s1.relaxation.driver = crate::spec::Driver::fire();
     let mut a = from_packing(&s1, Law::from_params(&s1.contact), loose)?;

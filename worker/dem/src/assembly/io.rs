@@ -5,7 +5,9 @@
 //! self-describing format) after its length as a little-endian `u64`; the state (contact law,
 //! reference, time step, committed and trial state) in postcard, whose wire format is
 //! specified and writes every `f64` as its 8 little-endian bytes, so a state reads back bit
-//! for bit; and last a CRC-32 (IEEE, little-endian) of every byte before it.
+//! for bit; when the spec's `relaxation.predictor` is `extrapolated`, the last committed
+//! step's increment in postcard (so the bytes of every other assembly are unchanged); and last
+//! a CRC-32 (IEEE, little-endian) of every byte before it.
 //!
 //! The checksum is a CRC-32 (`crc32fast`) rather than a 64-bit hash: it is guaranteed to
 //! catch every single-bit error and every burst of up to 32 bits (what a damaged disk block or
@@ -18,8 +20,10 @@
 //! from either.
 
 use super::Assembly;
+use super::extrapolate::StepIncrement;
 use crate::error::{Error, Result};
 use crate::homogenize::for_each_contact;
+use crate::spec::Predictor;
 use cosdem_common::micro::MicroSnapshot;
 use serde::{Deserialize, Serialize};
 
@@ -110,6 +114,10 @@ impl Assembly {
         };
         let body = postcard::to_allocvec(&body).expect("encoding an assembly into memory");
         out.extend_from_slice(&body);
+        if self.spec.relaxation.predictor == Predictor::Extrapolated {
+            let step = postcard::to_allocvec(&self.last_step).expect("encoding into memory");
+            out.extend_from_slice(&step);
+        }
         let crc = crc32fast::hash(&out);
         out.extend_from_slice(&crc.to_le_bytes());
         out
@@ -161,6 +169,12 @@ impl Assembly {
         spec.validate()?;
         let (body, trailing): (Body, &[u8]) = postcard::take_from_bytes(&rest[len..])
             .map_err(|e| Error::Decode(format!("state body: {e}")))?;
+        let (last_step, trailing) = if spec.relaxation.predictor == Predictor::Extrapolated {
+            postcard::take_from_bytes::<Option<StepIncrement>>(trailing)
+                .map_err(|e| Error::Decode(format!("last step: {e}")))?
+        } else {
+            (None, trailing)
+        };
         if !trailing.is_empty() {
             return Err(Error::Decode(format!("state body: {} trailing bytes", trailing.len())));
         }
@@ -188,7 +202,12 @@ impl Assembly {
         let sizes =
             [&refc.inv_m, &refc.inv_i, &refc.x0, &refc.y0, &refc.th0].iter().all(|v| v.len() == n)
                 && refc.boundary.iter().all(|&k| (k as usize) < n);
-        if !sizes || !ok(&body.committed) || !body.trial.as_ref().is_none_or(ok) {
+        let step_ok = |s: &StepIncrement| [&s.dx, &s.dy, &s.dth].iter().all(|v| v.len() == n);
+        if !sizes
+            || !ok(&body.committed)
+            || !body.trial.as_ref().is_none_or(ok)
+            || !last_step.as_ref().is_none_or(step_ok)
+        {
             return Err(Error::Decode("state body: inconsistent array sizes".into()));
         }
         Ok(Assembly {
@@ -198,6 +217,7 @@ impl Assembly {
             dt: body.dt,
             committed: body.committed,
             trial: body.trial,
+            last_step,
             work: Default::default(),
         })
     }

@@ -3,6 +3,8 @@
 
 /// Building an assembly from its spec (packings, masses, time step).
 mod build;
+/// The extrapolated predictor: the last committed step's non-affine increment.
+pub mod extrapolate;
 /// Perturbation columns and shortcut answers in the reference or the current frame.
 mod frame;
 /// Byte encoding and snapshots.
@@ -14,6 +16,7 @@ mod shortcut;
 /// The trial solve: affine predictor, relaxation, homogenization, tangents.
 mod solve;
 
+pub use extrapolate::StepIncrement;
 pub use io::{ContactForce, Snapshot};
 pub use shortcut::{MARGIN as SHORTCUT_MARGIN, Relaxed};
 
@@ -22,7 +25,7 @@ use crate::boundary::periodic;
 use crate::broadphase::{Domain, PairList};
 use crate::contact::Law;
 use crate::integrate::{Dynamics, System, Work};
-use crate::spec::{AssemblySpec, BoundarySpec};
+use crate::spec::{AssemblySpec, BoundarySpec, Predictor};
 use cosdem_common::MacroDeformation;
 use serde::{Deserialize, Serialize};
 
@@ -81,13 +84,17 @@ pub struct Assembly {
     dt: f64,
     committed: State,
     trial: Option<State>,
+    /// The non-affine increment of the step that ended at `committed` (kept only with
+    /// `relaxation.predictor = "extrapolated"`).
+    last_step: Option<StepIncrement>,
     work: Work,
 }
 
 impl Assembly {
     /// Builds the packing of `spec` (equilibrating random ones at their confining stress).
     pub fn new(spec: &AssemblySpec) -> crate::Result<Assembly> {
-        build::new(spec)
+        // The specimen's own preparation is no load step to extrapolate from.
+        build::new(spec).map(|a| Assembly { last_step: None, ..a })
     }
 
     /// Number of discs.
@@ -125,6 +132,12 @@ impl Assembly {
         &self.committed
     }
 
+    /// The non-affine increment of the last committed step, kept for the extrapolated
+    /// predictor (None with the affine predictor and before the first commit).
+    pub fn last_step(&self) -> Option<&StepIncrement> {
+        self.last_step.as_ref()
+    }
+
     /// The last trial state, if a solve happened since the last commit/rollback.
     pub fn trial(&self) -> Option<&State> {
         self.trial.as_ref()
@@ -133,6 +146,8 @@ impl Assembly {
     /// Accepts the last trial state (no-op without one).
     pub fn commit(&mut self) {
         if let Some(t) = self.trial.take() {
+            self.last_step = (self.spec.relaxation.predictor == Predictor::Extrapolated)
+                .then(|| self.step_increment(&self.committed, &t));
             self.committed = t;
         }
     }

@@ -1,3 +1,4 @@
+use super::extrapolate::Shift;
 use super::{Assembly, State};
 use crate::boundary::{mat_inv, mat_mul, rotation_angle};
 use crate::broadphase;
@@ -46,12 +47,13 @@ impl Assembly {
     pub fn solve_relaxed(&mut self, target: &MacroDeformation) -> Result<MicroResponse> {
         target.validate()?;
         let t0 = Instant::now();
-        let start = match (&self.trial, self.spec.warm_start) {
-            (Some(t), true) => t.clone(),
-            _ => self.committed.clone(),
+        let (start, shift) = match (&self.trial, self.spec.warm_start) {
+            // A warm trial already holds this step's own non-affine part: no extrapolation.
+            (Some(t), true) => (t.clone(), None),
+            _ => (self.committed.clone(), self.extrapolation(target)),
         };
         let tol = self.spec.relaxation.tolerance;
-        let (st, rep) = self.relax_to(start, target, tol)?;
+        let (st, rep) = self.relax_to_from(start, target, tol, shift.as_ref())?;
         let h = self.homogenized(&st);
         let (tangent, tangent_steps) = match self.spec.tangent {
             TangentKind::Paper => (h.paper, 0),
@@ -126,7 +128,21 @@ impl Assembly {
         target: &MacroDeformation,
         tol: f64,
     ) -> Result<(State, RelaxReport)> {
+        self.relax_to_from(st, target, tol, None)
+    }
+
+    /// [`Assembly::relax_to`] with the first jump shifted by the extrapolated predictor's
+    /// `shift` (the shift of the whole increment, scaled to the first sub-increment's share).
+    fn relax_to_from(
+        &mut self,
+        st: State,
+        target: &MacroDeformation,
+        tol: f64,
+        shift: Option<&Shift>,
+    ) -> Result<(State, RelaxReport)> {
         let n = self.substeps(&st.target, target);
+        let first = shift.map(|s| s.scaled(1.0 / n as f64));
+        let mut first = first.as_ref();
         let from = st.target;
         let (mut st, mut steps, mut all_converged) = (st, 0u64, true);
         for i in 1..n {
@@ -136,12 +152,12 @@ impl Assembly {
                     super::path::interpolate_polar(&from, target, i as f64 / n as f64)
                 }
             };
-            let (s, rep) = self.relax_capped(st, &t, tol, u64::MAX)?;
+            let (s, rep) = self.relax_capped(st, &t, tol, u64::MAX, first.take())?;
             steps = steps.saturating_add(rep.steps);
             all_converged &= rep.converged;
             st = s;
         }
-        let (st, rep) = self.relax_capped(st, target, tol, u64::MAX)?;
+        let (st, rep) = self.relax_capped(st, target, tol, u64::MAX, first)?;
         let converged = rep.converged && all_converged;
         Ok((st, RelaxReport { steps: steps.saturating_add(rep.steps), converged, ..rep }))
     }
@@ -169,9 +185,10 @@ impl Assembly {
         target: &MacroDeformation,
         tol: f64,
         max_steps: u64,
+        shift: Option<&Shift>,
     ) -> Result<(State, RelaxReport)> {
         target.validate()?;
-        self.predict(&mut st, target);
+        self.predict(&mut st, target, shift);
         let mut work = std::mem::take(&mut self.work);
         let law = self.law;
         let pen = self.penalty(target);
@@ -233,7 +250,7 @@ impl Assembly {
     ) -> Result<u64> {
         target.validate()?;
         let mut st = self.committed.clone();
-        self.predict(&mut st, target);
+        self.predict(&mut st, target, None);
         let mut work = std::mem::take(&mut self.work);
         let law = self.law;
         let pen = self.penalty(target);
@@ -254,19 +271,16 @@ impl Assembly {
         Ok(rep.steps.max(steps))
     }
 
-    /// The affine predictor: every centre is mapped by `dF = F_new F_old^-1` about `X_c`,
-    /// every rotation advanced by the increment of its target rotation (penalty: `wbar +
-    /// kbar . (X_q - X_c)`; periodic: the continuum rotation), and the contact histories by the
-    /// slip and relative rotation of this jump (slip from the exact rotation of the branch
-    /// vector, so a rigid rotation leaves the histories untouched). Velocities are zeroed and
-    /// the pair list rebuilt.
-    fn predict(&self, st: &mut State, target: &MacroDeformation) {
-        let old = st.target;
-        let df = mat_mul(&target.f, &mat_inv(&old.f));
+    /// The rotation increment of every disc in the affine jump from `old` to `target`
+    /// (penalty: `dw + dk . (X_q - X_c)`; periodic: the continuum rotation's increment).
+    pub(super) fn affine_rotations(
+        &self,
+        old: &MacroDeformation,
+        target: &MacroDeformation,
+    ) -> Vec<f64> {
         let xc = self.refc.xc;
         let n = self.disc_count();
-        let periodic = matches!(self.spec.boundary, BoundarySpec::Periodic);
-        let dth: Vec<f64> = if periodic {
+        if matches!(self.spec.boundary, BoundarySpec::Periodic) {
             vec![rotation_angle(&target.f) - rotation_angle(&old.f); n]
         } else {
             let (dw, dk) = (
@@ -278,7 +292,28 @@ impl Assembly {
                     dw + dk[0].mul_add(self.refc.x0[q] - xc[0], dk[1] * (self.refc.y0[q] - xc[1]))
                 })
                 .collect()
-        };
+        }
+    }
+
+    /// The affine predictor: every centre is mapped by `dF = F_new F_old^-1` about `X_c`,
+    /// every rotation advanced by the increment of its target rotation (penalty: `wbar +
+    /// kbar . (X_q - X_c)`; periodic: the continuum rotation), and the contact histories by the
+    /// slip and relative rotation of this jump (slip from the exact rotation of the branch
+    /// vector, so a rigid rotation leaves the histories untouched). Velocities are zeroed and
+    /// the pair list rebuilt. With a `shift` (the extrapolated predictor), every disc moves and
+    /// turns by its share of it on top of the affine jump, and the histories follow that
+    /// relative motion too.
+    fn predict(&self, st: &mut State, target: &MacroDeformation, shift: Option<&Shift>) {
+        let old = st.target;
+        let df = mat_mul(&target.f, &mat_inv(&old.f));
+        let xc = self.refc.xc;
+        let n = self.disc_count();
+        let mut dth = self.affine_rotations(&old, target);
+        if let Some(s) = shift {
+            for (d, e) in dth.iter_mut().zip(&s.dth) {
+                *d += e;
+            }
+        }
         let law = &self.law;
         let r = &self.refc.r;
         let d = &mut st.dynamics;
@@ -292,8 +327,12 @@ impl Assembly {
                 lx += pl.ox[k];
                 ly += pl.oy[k];
             }
-            let nx = df[0][0].mul_add(lx, df[0][1] * ly);
-            let ny = df[1][0].mul_add(lx, df[1][1] * ly);
+            let mut nx = df[0][0].mul_add(lx, df[0][1] * ly);
+            let mut ny = df[1][0].mul_add(lx, df[1][1] * ly);
+            if let Some(s) = shift {
+                nx += s.dx[j] - s.dx[i];
+                ny += s.dy[j] - s.dy[i];
+            }
             let len = nx.hypot(ny);
             let ov = r[i] + r[j] - len;
             if ov <= 0.0 {
@@ -317,6 +356,12 @@ impl Assembly {
             d.x[q] = xc[0] + df[0][0].mul_add(px, df[0][1] * py);
             d.y[q] = xc[1] + df[1][0].mul_add(px, df[1][1] * py);
             d.th[q] += dth[q];
+        }
+        if let Some(s) = shift {
+            for q in 0..n {
+                d.x[q] += s.dx[q];
+                d.y[q] += s.dy[q];
+            }
         }
         d.stop();
         st.target = *target;
@@ -352,7 +397,7 @@ impl Assembly {
             let mut s = [[0.0; N]; 2];
             for (side, sign) in [(0usize, 1.0f64), (1, -1.0)] {
                 let t = super::frame::perturbed(&base, col, sign * h, self.spec.frame);
-                let (pst, rep) = self.relax_capped(st.clone(), &t, tol, cap)?;
+                let (pst, rep) = self.relax_capped(st.clone(), &t, tol, cap, None)?;
                 steps += rep.steps;
                 s[side] = self.homogenized(&pst).stress;
             }

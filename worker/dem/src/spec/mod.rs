@@ -44,7 +44,7 @@ pub use boundary::BoundarySpec;
 pub use contact::{ContactParams, NormalModel, RollingModel, TangentialModel};
 pub use packing::{Lattice, LatticeOrientation, MAX_DISCS, MAX_LATTICE_OVERLAP, PackingSpec};
 pub use relaxation::{
-    Criterion, Driver, FIRE_CEILING, MAX_RELAXATION_STEPS, MAX_SUBSTEPS, RelaxationSpec,
+    Criterion, Driver, FIRE_CEILING, MAX_RELAXATION_STEPS, MAX_SUBSTEPS, Predictor, RelaxationSpec,
 };
 pub use size::{STATE_BYTES_PER_DISC, STATE_ENVELOPE_BYTES, STATE_FIXED_BYTES, state_bytes};
 pub use tangent::{MAX_TANGENT_STRAIN, SECANT_RANGE, TangentFrame, TangentKind};

@@ -68,7 +68,8 @@ pub const STATE_FIXED_BYTES: u64 = 4096;
 /// (16 bytes), an explicit radius in the spec's JSON (at most 25 bytes), and its share of
 /// the Verlet pairs (indices as varints, periodic offsets, tangential and rolling histories:
 /// at most 42 bytes a pair; about 3 pairs a disc with the default skin, 9 with the largest
-/// skin of a hexagonal packing).
+/// skin of a hexagonal packing), and with the extrapolated predictor its last step's
+/// non-affine increment (24 bytes).
 pub const STATE_BYTES_PER_DISC: u64 = 560;
 
 /// An upper bound on the encoded size of one exported `AssemblyState` (protocol envelope
@@ -180,6 +181,11 @@ mod tests {
             ("random periodic skin 2", random("periodic", vec![], 2.0)),
             ("random penalty skin 2", random("penalty", vec![], 2.0)),
             ("radii periodic skin 2", random("periodic", radii, 2.0)),
+            ("random penalty skin 2, extrapolated", {
+                let mut s = random("penalty", vec![], 2.0);
+                s.relaxation.predictor = super::super::Predictor::Extrapolated;
+                s
+            }),
         ];
         let target = MacroDeformation::from_gradient([[-2e-3, 5e-4], [0.0, -1e-3]], 0.0, [0.0; 2]);
         for (name, s) in cases {
