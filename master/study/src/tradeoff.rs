@@ -145,7 +145,8 @@ pub(crate) type Reference = (CurveMetrics, Vec<(f64, f64)>, f64);
 pub const VARIANT_FILE: &str = "variant.json";
 
 /// The run in `dir`, if it is a run of `job` that ended: [`VARIANT_FILE`] holds this very
-/// job, `summary.json` says `finished` or `failed: ...` (both are the job's deterministic
+/// job (keys the job schema gained since it was written read as their defaults: the 10 mm
+/// sweeps of 2026-12-04 predate `loading.control` and `output.vtk_format`), `summary.json` says `finished` or `failed: ...` (both are the job's deterministic
 /// outcome), and `curve.csv` has one row per step the summary counts. A run that was still
 /// going or was interrupted, a run of another job (another setting, another scene, a
 /// directory of another sweep), or a directory that cannot be read gives `None`: the variant
@@ -154,8 +155,11 @@ pub fn ended_run(
     dir: &std::path::Path,
     job: &Job,
 ) -> Option<(cosdem_app::output::run_dir::Summary, Vec<(f64, f64)>)> {
-    let recorded = std::fs::read_to_string(dir.join(VARIANT_FILE)).ok()?;
-    if recorded != serde_json::to_string_pretty(job).ok()? {
+    // Read back as a job: a key the job gained after the run was recorded takes its default,
+    // so a run of the same job by an earlier cosdem is still this job's.
+    let recorded: Job =
+        serde_json::from_str(&std::fs::read_to_string(dir.join(VARIANT_FILE)).ok()?).ok()?;
+    if recorded != *job {
         return None;
     }
     let summary = cosdem_app::output::run_dir::Summary::read(dir).ok()?;

@@ -354,6 +354,33 @@ fn a_resumed_sweep_reads_the_ended_runs_and_runs_the_rest() {
     std::fs::remove_dir_all(&out).unwrap();
 }
 
+/// A run recorded by an earlier cosdem, whose job lacked keys added since (written without
+/// them, as the committed 10 mm sweeps are), is still its job's: the committed seed-9
+/// reference run of `docs/notes/tradeoff-biaxial-10mm-fixed/` is recognized as the
+/// reference of the biaxial example with seed 9, and not as the default's nor as another
+/// seed's reference.
+#[test]
+fn a_run_recorded_before_keys_were_added_is_still_its_jobs() {
+    let dir = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../docs/notes/tradeoff-biaxial-10mm-fixed/seed-9/runs/reference_tight"
+    );
+    let recorded = std::fs::read_to_string(format!("{dir}/{VARIANT_FILE}")).unwrap();
+    assert!(!recorded.contains("vtk_format"), "the committed run predates the key");
+    let example = include_str!("../../../../examples/biaxial.toml");
+    let seeded = |n: u32| {
+        let toml = example.replace("seed = 7", &format!("seed = {n}"));
+        Job::from_toml(&toml, "biaxial").unwrap()
+    };
+    let seed9 = seeded(9);
+    let (summary, curve) = ended_run(std::path::Path::new(dir), &reference(&seed9).job)
+        .expect("the committed reference is the seed-9 reference");
+    assert_eq!(summary.dem_steps, 670_679_280);
+    assert_eq!(curve.len() as u64, summary.steps);
+    assert!(ended_run(std::path::Path::new(dir), &seed9).is_none(), "not the default's run");
+    assert!(ended_run(std::path::Path::new(dir), &reference(&seeded(8)).job).is_none());
+}
+
 fn assembly_of(job: &Job) -> Option<&cosdem_dem::AssemblySpec> {
     match &job.material {
         MaterialSection::Dem { assembly } => Some(assembly),
