@@ -245,7 +245,7 @@ impl Knob {
             Knob::RelaxationSkipBelow => format!("{:e}", a.relaxation.skip_below),
             Knob::RelaxationElasticShortcut => a.relaxation.elastic_shortcut.to_string(),
             Knob::RelaxationSubstep => format!("{:e}", a.relaxation.substep),
-            Knob::RelaxationPredictor => predictor_name(a.relaxation.predictor).into(),
+            Knob::RelaxationPredictor => predictor_name(a.relaxation.predictor),
             Knob::AssemblySide => match a.packing.side() {
                 Some(side) => format!("{side} m"),
                 None => format!("given ({} packing)", a.packing.kind()),
@@ -317,10 +317,9 @@ impl Knob {
             Knob::RelaxationElasticShortcut => a.relaxation.elastic_shortcut = flag()?,
             Knob::RelaxationSubstep => a.relaxation.substep = number().ok_or_else(unknown)?,
             Knob::RelaxationPredictor => {
-                a.relaxation.predictor = [Predictor::Affine, Predictor::Extrapolated]
-                    .into_iter()
-                    .find(|p| predictor_name(*p) == setting)
-                    .ok_or_else(unknown)?;
+                // The job file's name of the value (serde), as for the tangent.
+                let named = serde_json::Value::String(setting.to_string());
+                a.relaxation.predictor = serde_json::from_value(named).map_err(|_| unknown())?;
             }
             Knob::AssemblySide => {
                 let s = number().ok_or_else(unknown)?;
@@ -427,7 +426,7 @@ impl Knob {
             }
             // The initial guess of issue 30, item 1 (docs/notes/2026-12-08-extrapolated-predictor.md).
             Knob::RelaxationPredictor if a.relaxation.predictor == Predictor::Affine => {
-                vec![predictor_name(Predictor::Extrapolated).into()]
+                vec![predictor_name(Predictor::Extrapolated)]
             }
             Knob::AssemblySide => return side_moves(base, a),
             _ => Vec::new(),
@@ -450,12 +449,13 @@ impl std::str::FromStr for Knob {
     }
 }
 
-/// The job file's name of a predictor (`affine`, `extrapolated`).
-fn predictor_name(p: Predictor) -> &'static str {
-    match p {
-        Predictor::Affine => "affine",
-        Predictor::Extrapolated => "extrapolated",
-    }
+/// The job file's name of a predictor (`affine`, `extrapolated`): its serde name, so a new
+/// predictor needs no change here.
+fn predictor_name(p: Predictor) -> String {
+    serde_json::to_value(p)
+        .ok()
+        .and_then(|v| v.as_str().map(str::to_string))
+        .unwrap_or_else(|| format!("{p:?}"))
 }
 
 /// Multiplies the job's load step by `f` (a job given by its step count takes `1/f` as many,

@@ -95,9 +95,6 @@ fn respec(mut a: Assembly, spec: &AssemblySpec) -> Result<Assembly> {
     a.refc.inv_i = inv_i;
     a.dt = dt;
     a.spec = spec.clone();
-    if spec.relaxation.predictor != crate::spec::Predictor::Extrapolated {
-        a.last_step = None;
-    }
     Ok(a)
 }
 
